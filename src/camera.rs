@@ -1,0 +1,101 @@
+//! The camera and the screen rectangle it looks through: one primary ray per pixel.
+
+use crate::ray::Ray;
+use crate::Vec3;
+
+/// The screen: an axis-aligned rectangle in the plane `z = 0`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Screen {
+    /// x of the left edge.
+    pub left: f64,
+    /// x of the right edge (greater than `left`).
+    pub right: f64,
+    /// y of the top edge (greater than `bottom`).
+    pub top: f64,
+    /// y of the bottom edge.
+    pub bottom: f64,
+}
+
+impl Screen {
+    /// The tutorial's screen for an image of `width` × `height` pixels:
+    /// x from -1 to 1 and y from -1/ratio to 1/ratio, with ratio = width / height,
+    /// so that pixels are square.
+    pub fn for_image(width: u32, height: u32) -> Screen {
+        let ratio = f64::from(width) / f64::from(height);
+        Screen {
+            left: -1.0,
+            right: 1.0,
+            top: 1.0 / ratio,
+            bottom: -1.0 / ratio,
+        }
+    }
+}
+
+/// An eye at `position` looking through `screen`, sampled by `width` × `height` pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// The eye: every primary ray starts here.
+    pub position: Vec3,
+    /// The rectangle the eye looks through.
+    pub screen: Screen,
+    /// Columns of the image.
+    pub width: u32,
+    /// Rows of the image.
+    pub height: u32,
+}
+
+// ANCHOR: primary_ray
+impl Camera {
+    /// The point of the screen that pixel (`row` from the top, `col` from the left)
+    /// looks at. As in the tutorial, the first and last pixels sit exactly on the
+    /// screen's edges: `x = left + col·(right − left)/(W − 1)`.
+    pub fn screen_point(&self, row: u32, col: u32) -> Vec3 {
+        let s = &self.screen;
+        let x = lerp_on_grid(s.left, s.right, col, self.width);
+        let y = lerp_on_grid(s.top, s.bottom, row, self.height);
+        Vec3::new(x, y, 0.0)
+    }
+
+    /// The ray from the eye through the pixel's screen point.
+    pub fn primary_ray(&self, row: u32, col: u32) -> Ray {
+        Ray::towards(self.position, self.screen_point(row, col))
+    }
+}
+
+/// Sample `i` of `n` evenly spaced values from `from` to `to`, both ends included
+/// (numpy's `linspace`); a single sample sits in the middle.
+fn lerp_on_grid(from: f64, to: f64, i: u32, n: u32) -> f64 {
+    if n < 2 {
+        return 0.5 * (from + to);
+    }
+    from + f64::from(i) * (to - from) / f64::from(n - 1)
+}
+// ANCHOR_END: primary_ray
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera(width: u32, height: u32) -> Camera {
+        Camera {
+            position: Vec3::new(0.0, 0.0, 1.0),
+            screen: Screen::for_image(width, height),
+            width,
+            height,
+        }
+    }
+
+    #[test]
+    fn corner_pixels_sit_on_the_screen_corners() {
+        let cam = camera(300, 200);
+        assert_eq!(cam.screen_point(0, 0), Vec3::new(-1.0, 2.0 / 3.0, 0.0));
+        assert_eq!(cam.screen_point(199, 299), Vec3::new(1.0, -2.0 / 3.0, 0.0));
+    }
+
+    #[test]
+    fn a_one_pixel_image_looks_at_the_screen_centre() {
+        let cam = camera(1, 1);
+        assert_eq!(cam.screen_point(0, 0), Vec3::ZERO);
+        assert_eq!(cam.primary_ray(0, 0).direction, Vec3::new(0.0, 0.0, -1.0));
+    }
+}

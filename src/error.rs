@@ -1,0 +1,43 @@
+//! Errors a user can cause, each a message that says what is wrong and what would
+//! be valid. The command line prints them and exits with [`USER_ERROR`].
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// The exit code for every mistake a user can make (bad scene, flag or folder).
+pub const USER_ERROR: i32 = 2;
+
+/// Something raystep was asked to do and cannot.
+#[derive(Debug)]
+pub enum Error {
+    /// A scene that cannot be read, parsed or accepted.
+    Scene {
+        /// The file (or the name of the built-in scene).
+        file: String,
+        /// What is wrong, naming the key or line, and what is valid.
+        message: String,
+    },
+    /// Options that cannot work together.
+    Usage(String),
+    /// A file or folder that cannot be written.
+    Output {
+        /// The path that failed.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Scene { file, message } => write!(f, "{file}: {message}"),
+            Error::Usage(message) => f.write_str(message),
+            Error::Output { path, message } => {
+                write!(f, "cannot write {}: {message}", path.display())
+            }
+        }
+    }
+}
+
+impl std::error::Error for Error {}

@@ -1,0 +1,44 @@
+//! # raystep: ray tracing, one step at a time
+//!
+//! raystep follows the tutorial "Ray Tracing From Scratch in Python" (Omar Aflak,
+//! 2020) one stage at a time. The whole pipeline, for every pixel of the image:
+//!
+//! ```text
+//! scene file ──► Scene ──► for each pixel:
+//!     camera + screen rectangle ──► primary ray            (camera, ray)     stage `rays`
+//!     nearest object along the ray ──► hit point, normal   (sphere, scene)   stage `intersection`
+//!     anything between the hit point and the light?       (shade::shadow)   stage `shadow`
+//!     ambient + diffuse + specular                          (shade::blinn_phong) stage `blinn-phong`
+//!     bounce off the surface, add the weighted colour       (shade::reflection)  stage `reflection`
+//!     the floor ("fake plane") takes part                   (plane)           stage `plane`
+//! ──► colour clipped to [0, 1] and the first-hit record ──► buffers (aov) ──► PNG + EXR (output)
+//! ```
+//!
+//! The modules below are listed in the order the book introduces them, so this
+//! file reads as its table of contents.
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+/// The 3-vector used for points, directions and colours (float64).
+pub use glam::DVec3 as Vec3;
+
+// Chapter 1: setting the scene.
+pub mod camera;
+pub mod scene;
+pub mod scene_file;
+// Chapter 2: rays.
+pub mod ray;
+// Chapter 3: intersection.
+pub mod sphere;
+// Chapters 4-6: shadow, Blinn-Phong, reflection.
+pub mod shade;
+// Chapter 7: the plane.
+pub mod plane;
+// The switches, the pixel loop and what it writes.
+pub mod aov;
+pub mod output;
+pub mod render;
+pub mod stages;
+// The command line and its errors.
+pub mod cli;
+pub mod error;

@@ -1,0 +1,151 @@
+//! The pixel loop: the tutorial's pseudocode, run on every pixel in parallel.
+//!
+//! Every pixel is computed on its own from the scene alone, so the image is the
+//! same, byte for byte, whatever the number of threads.
+
+use rayon::prelude::*;
+
+use crate::aov::{FirstHit, Frame, PixelRecord};
+use crate::camera::Camera;
+use crate::ray::Ray;
+use crate::scene::{nearest_hit, Light, Object, Scene};
+use crate::shade::{blinn_phong, reflection, shadow};
+use crate::stages::Stages;
+use crate::Vec3;
+
+/// What the render needs to follow one ray: the scene reduced to what the enabled
+/// stages use.
+pub struct Tracer {
+    /// The stages that are on.
+    pub stages: Stages,
+    /// The camera: where primary rays start, and the viewer of Blinn-Phong.
+    pub camera: Camera,
+    /// The objects in play under `stages`.
+    pub objects: Vec<Object>,
+    /// The point light.
+    pub light: Light,
+    /// Most segments of a path, when the `reflection` stage is on.
+    pub max_depth: u32,
+}
+
+/// The colour a ray brings back and what its first hit left for the buffers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Traced {
+    /// Colour clipped to [0, 1].
+    pub colour: Vec3,
+    /// The first hit, or `None` if the ray hit nothing.
+    pub first: Option<FirstHit>,
+}
+
+impl Tracer {
+    /// The tracer of `scene` under `stages`.
+    pub fn new(scene: &Scene, stages: Stages) -> Tracer {
+        Tracer {
+            stages,
+            camera: scene.camera(),
+            objects: scene.objects_in_play(stages),
+            light: scene.light,
+            max_depth: scene.max_depth,
+        }
+    }
+
+    // ANCHOR: pixel
+    /// The record of pixel (`row`, `col`). With only the `rays` stage on, the colour
+    /// shows the ray's direction: each component mapped from [−1, 1] to [0, 1].
+    pub fn pixel(&self, row: u32, col: u32) -> PixelRecord {
+        let ray = self.camera.primary_ray(row, col);
+        if !self.stages.intersection {
+            let colour = (ray.direction + Vec3::ONE) * 0.5;
+            return PixelRecord::new(ray.direction, colour, None);
+        }
+        let traced = self.trace(ray);
+        PixelRecord::new(ray.direction, traced.colour, traced.first)
+    }
+    // ANCHOR_END: pixel
+
+    // ANCHOR: trace
+    /// Follow a ray through the scene, as the tutorial's final program does.
+    pub fn trace(&self, primary: Ray) -> Traced {
+        let segments = if self.stages.reflection {
+            self.max_depth
+        } else {
+            1
+        };
+        let mut colour = Vec3::ZERO;
+        let mut weight = 1.0;
+        let mut ray = primary;
+        let mut first = None;
+        for segment in 0..segments {
+            // The nearest object along the ray; if there is none, the path ends.
+            let Some(hit) = nearest_hit(&self.objects, &ray) else {
+                break;
+            };
+            let object = &self.objects[hit.object];
+            let point = ray.at(hit.t);
+            let normal = object.normal_at(point, &ray);
+            let shifted = shadow::step_off(point, normal);
+            let to_light = (self.light.position - shifted).normalize();
+
+            // Shadow: a point that does not see the light ends the path, black.
+            let lit = !self.stages.shadow || {
+                let light_distance = self.light.position.distance(point);
+                !shadow::in_shadow(&self.objects, shifted, to_light, light_distance)
+            };
+            if segment == 0 {
+                first = Some(FirstHit {
+                    depth: hit.t,
+                    normal,
+                    lit,
+                    object: hit.object,
+                });
+            }
+            if !lit {
+                break;
+            }
+
+            // Blinn-Phong, seen from the camera (on every bounce, as in the tutorial).
+            let illumination = if self.stages.blinn_phong {
+                let to_viewer = (self.camera.position - point).normalize();
+                blinn_phong::illuminate(&object.material, &self.light, normal, to_light, to_viewer)
+            } else {
+                object.material.diffuse
+            };
+
+            // Reflection: add this segment's light, weighted, and bounce.
+            colour += weight * illumination;
+            weight *= object.material.reflection;
+            ray = reflection::reflected_ray(shifted, &ray, normal);
+        }
+        Traced {
+            colour: colour.clamp(Vec3::ZERO, Vec3::ONE),
+            first,
+        }
+    }
+    // ANCHOR_END: trace
+}
+
+// ANCHOR: render
+/// Render `scene` under `stages`. `progress(1)` is called, from any thread, each
+/// time a row is finished.
+pub fn render(scene: &Scene, stages: Stages, progress: &(dyn Fn(u64) + Sync)) -> Frame {
+    let tracer = Tracer::new(scene, stages);
+    let width = scene.width as usize;
+    let mut pixels =
+        vec![PixelRecord::new(Vec3::ZERO, Vec3::ZERO, None); width * scene.height as usize];
+    pixels
+        .par_chunks_mut(width)
+        .enumerate()
+        .for_each(|(row, line)| {
+            for (col, pixel) in line.iter_mut().enumerate() {
+                *pixel = tracer.pixel(row as u32, col as u32);
+            }
+            progress(1);
+        });
+    Frame {
+        width: scene.width,
+        height: scene.height,
+        has_surface_buffers: stages.intersection,
+        pixels,
+    }
+}
+// ANCHOR_END: render

@@ -1,0 +1,242 @@
+//! The `raystep` binary as a user runs it: the default command, `render`, `check`,
+//! and mistakes, which must end in one clear message and exit code 2.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn raystep(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_raystep"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+fn png_size(path: &Path) -> (u32, u32) {
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(
+        &bytes[..8],
+        b"\x89PNG\r\n\x1a\n",
+        "{} is a PNG",
+        path.display()
+    );
+    let be = |i: usize| u32::from_be_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    (be(16), be(20))
+}
+
+#[test]
+fn no_arguments_renders_every_stage_of_the_built_in_scene_from_any_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = raystep(dir.path(), &[]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // Quiet on stderr when it is not a terminal: no progress bar, no warnings.
+    assert_eq!(text(&out.stderr), "");
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("wrote 6 stages"), "{stdout}");
+    for (folder, files) in [
+        (
+            "01-rays",
+            &["beauty.png", "direction.png", "buffers.exr"][..],
+        ),
+        (
+            "06-plane",
+            &[
+                "beauty.png",
+                "direction.png",
+                "depth.png",
+                "normal.png",
+                "shadow.png",
+                "buffers.exr",
+            ][..],
+        ),
+    ] {
+        for file in files {
+            assert!(
+                dir.path().join("out").join(folder).join(file).is_file(),
+                "{folder}/{file}"
+            );
+        }
+    }
+    assert!(!dir.path().join("out/01-rays/depth.png").exists());
+    assert_eq!(
+        png_size(&dir.path().join("out/06-plane/beauty.png")),
+        (300, 200)
+    );
+    let folders = std::fs::read_dir(dir.path().join("out")).unwrap().count();
+    assert_eq!(folders, 6);
+}
+
+#[test]
+fn render_writes_one_configuration_at_the_size_asked_and_no_temporary_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/seed.toml");
+    let args = [
+        "render",
+        scene,
+        "--stage",
+        "plane",
+        "--without",
+        "shadow",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--out",
+        "here",
+    ];
+    let out = raystep(dir.path(), &args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("rays+intersection+blinn-phong+reflection+plane"));
+    let mut names: Vec<String> = std::fs::read_dir(dir.path().join("here"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "beauty.png",
+            "buffers.exr",
+            "depth.png",
+            "direction.png",
+            "normal.png",
+            "shadow.png"
+        ]
+    );
+    assert_eq!(png_size(&dir.path().join("here/depth.png")), (64, 48));
+
+    // A later rays-only render into the same folder removes the buffers it does not
+    // write, so the folder never mixes two renders.
+    let out = raystep(
+        dir.path(),
+        &["render", scene, "--stage", "rays", "--out", "here"],
+    );
+    assert!(out.status.success());
+    assert!(!dir.path().join("here/depth.png").exists());
+    assert_eq!(png_size(&dir.path().join("here/beauty.png")), (300, 200));
+}
+
+#[test]
+fn check_describes_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/seed.toml");
+    let out = raystep(dir.path(), &["check", scene]);
+    assert!(out.status.success());
+    let stdout = text(&out.stdout);
+    for expected in [
+        "a valid scene",
+        "300 × 200",
+        "max_depth 3",
+        "3 spheres",
+        "radius 8999.3",
+        "1 planes",
+    ] {
+        assert!(stdout.contains(expected), "{expected:?} in\n{stdout}");
+    }
+}
+
+#[test]
+fn help_and_version_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = raystep(dir.path(), &["--version"]);
+    assert!(out.status.success());
+    assert!(text(&out.stdout).starts_with("raystep "));
+    for command in [
+        &["--help"][..],
+        &["render", "--help"],
+        &["stages", "--help"],
+        &["check", "--help"],
+    ] {
+        let out = raystep(dir.path(), command);
+        assert!(out.status.success(), "{command:?}");
+        assert!(text(&out.stdout).contains("Usage"), "{command:?}");
+    }
+    let out = raystep(dir.path(), &["render", "--help"]);
+    let help = text(&out.stdout);
+    for stage in [
+        "rays",
+        "intersection",
+        "shadow",
+        "blinn-phong",
+        "reflection",
+        "plane",
+    ] {
+        assert!(help.contains(stage), "{stage} in render --help");
+    }
+}
+
+/// The smallest valid scene, with `extra` appended.
+fn scene_with(extra: &str) -> String {
+    format!("[camera]\nposition = [0, 0, 1]\n[light]\nposition = [5, 5, 5]\n{extra}")
+}
+
+/// What went wrong, the scene file's text (None: no file), extra arguments, and the
+/// words the message must hold.
+type Case<'a> = (&'a str, Option<String>, Vec<&'a str>, Vec<&'a str>);
+
+#[test]
+fn mistakes_end_in_one_clear_message_and_exit_code_2() {
+    let sphere = |keys: &str| scene_with(&format!("[[sphere]]\ncenter = [0, 0, -1]\n{keys}\n"));
+    let cases: Vec<Case> = vec![
+        ("missing file", None, vec!["render", "nowhere.toml"], vec!["nowhere.toml", "cannot read"]),
+        ("TOML syntax", Some("[camera\nposition = [0, 0, 1]".into()), vec![], vec!["bad.toml", "line 1"]),
+        ("unknown key", Some(sphere("radus = 1")), vec![], vec!["unknown field `radus`", "radius"]),
+        ("wrong type", Some(sphere("radius = \"big\"")), vec![], vec!["invalid type", "radius", "line 7"]),
+        ("missing required key", Some(sphere("")), vec![], vec!["missing field `radius`"]),
+        ("missing camera", Some("[light]\nposition = [5, 5, 5]\n".into()), vec![], vec!["missing field `camera`"]),
+        ("negative radius", Some(sphere("radius = -1")), vec![], vec!["[[sphere]] number 1, radius", "greater than 0"]),
+        ("zero radius", Some(sphere("radius = 0")), vec![], vec!["radius", "greater than 0"]),
+        ("NaN", Some(sphere("radius = nan")), vec![], vec!["radius", "not a finite number"]),
+        ("infinity", Some(scene_with("[[sphere]]\ncenter = [0, inf, -1]\nradius = 1\n")), vec![], vec!["center", "not a finite number"]),
+        ("empty screen", Some(scene_with("[screen]\nleft = 1\nright = 1\n")), vec![], vec!["screen", "left (1) must be less than right (1)"]),
+        ("camera on the screen plane", Some("[camera]\nposition = [0, 0, 0]\n[light]\nposition = [5, 5, 5]\n".into()), vec![], vec!["camera.position", "z = 0"]),
+        ("zero-size image in the file", Some(scene_with("[image]\nwidth = 0\n")), vec![], vec!["image.width = 0", "1 to 16384"]),
+        ("negative size in the file", Some(scene_with("[image]\nheight = -5\n")), vec![], vec!["height", "invalid value"]),
+        ("zero width flag", Some(scene_with("")), vec!["--width", "0"], vec!["--width = 0", "1 to 16384"]),
+        ("absurd height flag", Some(scene_with("")), vec!["--height", "20000"], vec!["--height = 20000", "1 to 16384"]),
+        ("too many pixels", Some(scene_with("")), vec!["--width", "16384", "--height", "16384"], vec!["pixels", "at most"]),
+        ("max_depth 0", Some(scene_with("[render]\nmax_depth = 0\n")), vec![], vec!["render.max_depth = 0", "from 1 to 64"]),
+        ("reflection above 1", Some(sphere("radius = 1\nreflection = 2")), vec![], vec!["reflection", "from 0 (matte) to 1"]),
+        ("negative colour", Some(sphere("radius = 1\ndiffuse = [0.5, -1, 0]")), vec![], vec!["diffuse", "negative"]),
+        ("plane with two shapes", Some(scene_with("[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\nsphere = { center = [0, -9, 0], radius = 8 }\n")), vec![], vec!["[[plane]] number 1", "not both"]),
+        ("plane with a zero normal", Some(scene_with("[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 0, 0]\n")), vec![], vec!["normal", "non-zero"]),
+        ("not UTF-8", Some(String::from_utf8_lossy(&[0xff, 0xfe, 0x00]).into_owned()), vec![], vec!["bad.toml"]),
+        ("a stage without what it needs", Some(scene_with("")), vec!["--stage", "shadow", "--without", "intersection"], vec!["`shadow` cannot run without `intersection`"]),
+        ("unknown stage", Some(scene_with("")), vec!["--stage", "shadows"], vec!["invalid value 'shadows'", "shadow"]),
+        ("output folder is a file", Some(scene_with("")), vec!["--out", "bad.toml"], vec!["bad.toml", "is a file"]),
+        ("output folder inside a file", Some(scene_with("")), vec!["--out", "bad.toml/sub"], vec!["bad.toml/sub", "cannot create"]),
+    ];
+    for (what, file, extra, words) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        let mut args: Vec<&str> = vec![];
+        if let Some(text) = &file {
+            std::fs::write(dir.path().join("bad.toml"), text).unwrap();
+            args.extend(["render", "bad.toml"]);
+        }
+        args.extend(extra);
+        let out = raystep(dir.path(), &args);
+        let stderr = text(&out.stderr);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{what}: exit code; stderr:\n{stderr}"
+        );
+        assert!(
+            !stderr.contains("panicked") && !stderr.contains("backtrace"),
+            "{what}:\n{stderr}"
+        );
+        for word in words {
+            assert!(stderr.contains(word), "{what}: {word:?} not in:\n{stderr}");
+        }
+        // Nothing was written: the folder holds at most the scene file.
+        let left: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert!(left.len() <= 1, "{what}: left {left:?}");
+    }
+}

@@ -1,0 +1,58 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use raystep::aov::Frame;
+use raystep::scene::Scene;
+use raystep::stages::Stages;
+
+/// The built-in figure-1 scene at `width` × `height`.
+pub fn seed(width: u32, height: u32) -> Scene {
+    let mut scene = raystep::scene_file::seed();
+    scene.width = width;
+    scene.height = height;
+    scene
+}
+
+/// Render without progress reporting.
+pub fn render(scene: &Scene, stages: Stages) -> Frame {
+    raystep::render::render(scene, stages, &|_| {})
+}
+
+/// A scene from TOML text, which must be valid.
+pub fn scene(toml: &str) -> Scene {
+    raystep::scene_file::parse(toml, "test scene").unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Read a PFM file: (width, height, RGB triples with the top row first).
+pub fn read_pfm(bytes: &[u8]) -> (usize, usize, Vec<[f32; 3]>) {
+    let mut fields = Vec::new();
+    let mut pos = 0;
+    while fields.len() < 4 {
+        while bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        let start = pos;
+        while !bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        fields.push(std::str::from_utf8(&bytes[start..pos]).unwrap().to_string());
+    }
+    pos += 1; // the single whitespace byte after the scale
+    assert_eq!(fields[0], "PF", "a colour PFM");
+    let (w, h): (usize, usize) = (fields[1].parse().unwrap(), fields[2].parse().unwrap());
+    let scale: f32 = fields[3].parse().unwrap();
+    assert!(scale < 0.0, "little-endian PFM");
+    let floats: Vec<f32> = bytes[pos..]
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    assert_eq!(floats.len(), w * h * 3);
+    let mut rows: Vec<[f32; 3]> = Vec::with_capacity(w * h);
+    for row in (0..h).rev() {
+        for col in 0..w {
+            let i = (row * w + col) * 3;
+            rows.push([floats[i], floats[i + 1], floats[i + 2]]);
+        }
+    }
+    (w, h, rows)
+}
