@@ -8,9 +8,11 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::aov::Frame;
 use crate::error::Error;
-use crate::render::render;
+use crate::render::{render, Settings};
 use crate::scene::{Role, Scene, Shape};
-use crate::scene_file::{self, check_image_size};
+use crate::scene_file::{self, check_image_size, check_max_depth};
+use crate::shade::blinn_phong::Viewer;
+use crate::shade::shadow::Offset;
 use crate::stages::{Stage, Stages};
 
 /// raystep: a ray tracer that teaches ray tracing one step at a time.
@@ -34,6 +36,10 @@ pub enum Command {
     Render(RenderArgs),
     /// Check a scene file and print what it contains.
     Check(CheckArgs),
+    /// Compare the beauty of two renders (their buffers.exr files), pixel by pixel.
+    Diff(DiffArgs),
+    /// Render the book's figures into chapters/img (run from the repository's root).
+    Figures(FiguresArgs),
 }
 
 /// The scene to render and its size.
@@ -49,12 +55,31 @@ pub struct SceneArgs {
     pub height: Option<u32>,
 }
 
+/// Where raystep may differ from the tutorial's rules; the defaults are the tutorial's.
+#[derive(Args, Debug, Default)]
+pub struct RuleArgs {
+    /// How far shadow and reflected rays start from a hit point, along the normal:
+    /// fixed:VALUE. The tutorial's is fixed:1e-5; fixed:0 shows shadow acne.
+    #[arg(long, default_value_t = Offset::default(), value_name = "fixed:VALUE")]
+    pub offset: Offset,
+    /// Who views the highlight on a reflection bounce: the camera (the tutorial's
+    /// rule) or the ray's origin (the surface the light travels to).
+    #[arg(long, value_enum, default_value_t = Viewer::Camera)]
+    pub viewer: Viewer,
+    /// Most segments per pixel path (overrides the scene's render.max_depth; 1 to 64).
+    #[arg(long)]
+    pub max_depth: Option<u32>,
+}
+
 /// Arguments of `raystep stages`.
 #[derive(Args, Debug, Default)]
 pub struct StagesArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
     pub scene: SceneArgs,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub rules: RuleArgs,
     /// Output folder; each stage goes into a numbered folder inside it.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
@@ -72,6 +97,9 @@ pub struct RenderArgs {
     /// Turn one stage off again (repeatable), e.g. --stage plane --without shadow.
     #[arg(long, value_enum)]
     pub without: Vec<Stage>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub rules: RuleArgs,
     /// Output folder.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
@@ -84,6 +112,26 @@ pub struct CheckArgs {
     pub scene: PathBuf,
 }
 
+/// Arguments of `raystep diff`.
+#[derive(Args, Debug)]
+pub struct DiffArgs {
+    /// The first render's buffers.exr.
+    pub a: PathBuf,
+    /// The second render's buffers.exr.
+    pub b: PathBuf,
+}
+
+/// Arguments of `raystep figures`.
+#[derive(Args, Debug)]
+pub struct FiguresArgs {
+    /// Where the images go.
+    #[arg(long, default_value = "chapters/img")]
+    pub out: PathBuf,
+    /// Re-render and compare with the images in --out instead of writing them.
+    #[arg(long)]
+    pub check: bool,
+}
+
 /// Carry out a parsed command line.
 pub fn run(cli: Cli) -> Result<(), Error> {
     match cli.command {
@@ -91,6 +139,8 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Some(Command::Stages(args)) => stages(args),
         Some(Command::Render(args)) => render_one(args),
         Some(Command::Check(args)) => check(&args.scene),
+        Some(Command::Diff(args)) => diff(&args),
+        Some(Command::Figures(args)) => figures(&args),
     }
 }
 
@@ -98,17 +148,49 @@ impl StagesArgs {
     fn default_out() -> StagesArgs {
         StagesArgs {
             scene: SceneArgs::default(),
+            rules: RuleArgs::default(),
             out: PathBuf::from("out"),
         }
     }
 }
 
+impl RuleArgs {
+    /// The settings for `stages` under these rules; a `--max-depth` goes into `scene`.
+    fn apply(&self, scene: &mut Scene, stages: Stages) -> Result<Settings, Error> {
+        if let Some(depth) = self.max_depth {
+            check_max_depth(depth, "--max-depth").map_err(Error::Usage)?;
+            scene.max_depth = depth;
+        }
+        Ok(Settings {
+            stages,
+            offset: self.offset,
+            viewer: self.viewer,
+        })
+    }
+}
+
+/// The scene and settings a `render` command line asks for.
+pub fn prepare(args: &RenderArgs) -> Result<(Scene, Settings), Error> {
+    let stages = Stages::select(args.stage, &args.without).map_err(Error::Usage)?;
+    let (mut scene, _) = load_scene(&args.scene)?;
+    let settings = args.rules.apply(&mut scene, stages)?;
+    Ok((scene, settings))
+}
+
+fn scene_name(args: &SceneArgs) -> String {
+    match &args.scene {
+        Some(path) => path.display().to_string(),
+        None => scene_file::SEED_NAME.to_string(),
+    }
+}
+
 /// Load the scene named by `args` (or the built-in one) and apply the size flags.
 pub fn load_scene(args: &SceneArgs) -> Result<(Scene, String), Error> {
-    let (mut scene, name) = match &args.scene {
-        Some(path) => (scene_file::load(path)?, path.display().to_string()),
-        None => (scene_file::seed(), scene_file::SEED_NAME.to_string()),
+    let mut scene = match &args.scene {
+        Some(path) => scene_file::load(path)?,
+        None => scene_file::seed(),
     };
+    let name = scene_name(args);
     scene.width = args.width.unwrap_or(scene.width);
     scene.height = args.height.unwrap_or(scene.height);
     check_image_size(scene.width, scene.height, "--").map_err(Error::Usage)?;
@@ -116,7 +198,8 @@ pub fn load_scene(args: &SceneArgs) -> Result<(Scene, String), Error> {
 }
 
 fn stages(args: StagesArgs) -> Result<(), Error> {
-    let (scene, name) = load_scene(&args.scene)?;
+    let (mut scene, name) = load_scene(&args.scene)?;
+    let base = args.rules.apply(&mut scene, Stages::ALL)?;
     ensure_folder(&args.out)?;
     println!("{name}: every stage at {} × {}", scene.width, scene.height);
     let bar = progress_bar(u64::from(scene.height) * Stage::ALL.len() as u64);
@@ -124,7 +207,11 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
     for stage in Stage::ALL {
         bar.set_message(stage.folder());
         let dir = args.out.join(stage.folder());
-        let (frame, seconds) = timed(|| render(&scene, Stages::up_to(stage), &|n| bar.inc(n)));
+        let settings = Settings {
+            stages: Stages::up_to(stage),
+            ..base
+        };
+        let (frame, seconds) = timed(|| render(&scene, &settings, &|n| bar.inc(n)));
         write(&frame, &dir, seconds, &bar)?;
     }
     bar.finish_and_clear();
@@ -138,12 +225,15 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
 }
 
 fn render_one(args: RenderArgs) -> Result<(), Error> {
-    let stages = Stages::select(args.stage, &args.without).map_err(Error::Usage)?;
-    let (scene, name) = load_scene(&args.scene)?;
+    let (scene, settings) = prepare(&args)?;
     ensure_folder(&args.out)?;
-    println!("{name}: {stages} at {} × {}", scene.width, scene.height);
+    let name = scene_name(&args.scene);
+    println!(
+        "{name}: {} at {} × {}",
+        settings.stages, scene.width, scene.height
+    );
     let bar = progress_bar(u64::from(scene.height));
-    let (frame, seconds) = timed(|| render(&scene, stages, &|n| bar.inc(n)));
+    let (frame, seconds) = timed(|| render(&scene, &settings, &|n| bar.inc(n)));
     bar.finish_and_clear();
     write(&frame, &args.out, seconds, &bar)
 }
@@ -196,6 +286,65 @@ fn ensure_folder(dir: &Path) -> Result<(), Error> {
     })
 }
 
+fn diff(args: &DiffArgs) -> Result<(), Error> {
+    let (wa, ha, a) = crate::compare::read_beauty(&args.a)?;
+    let (wb, hb, b) = crate::compare::read_beauty(&args.b)?;
+    if (wa, ha) != (wb, hb) {
+        return Err(Error::Usage(format!(
+            "{} is {wa} × {ha} but {} is {wb} × {hb}: only renders of one size compare",
+            args.a.display(),
+            args.b.display()
+        )));
+    }
+    let d = crate::compare::compare(&a, &b, wa);
+    println!(
+        "{} against {}: {wa} × {ha} pixels",
+        args.a.display(),
+        args.b.display()
+    );
+    println!(
+        "  differ by more than 1/255: {} pixels ({:.2} %)",
+        d.over_one_step,
+        100.0 * d.over_one_step as f64 / d.pixels as f64
+    );
+    println!(
+        "  largest difference:        {:.4} (row {}, column {})",
+        d.largest, d.largest_at.0, d.largest_at.1
+    );
+    println!("  root mean square:          {:.6}", d.rmse);
+    println!(
+        "  clipped (a channel at 1):  {} and {} pixels",
+        d.saturated.0, d.saturated.1
+    );
+    Ok(())
+}
+
+fn figures(args: &FiguresArgs) -> Result<(), Error> {
+    let root = Path::new(".");
+    if args.check {
+        let problems = crate::figures::check_all(root, &args.out)?;
+        if problems.is_empty() {
+            println!(
+                "every figure in {} is what raystep renders now",
+                args.out.display()
+            );
+            return Ok(());
+        }
+        return Err(Error::Usage(format!(
+            "{} figure problems; run `raystep figures` to re-render:\n  {}",
+            problems.len(),
+            problems.join("\n  ")
+        )));
+    }
+    let written = crate::figures::write_all(root, &args.out)?;
+    println!(
+        "wrote {} figures into {}/",
+        written.len(),
+        args.out.display()
+    );
+    Ok(())
+}
+
 fn check(path: &Path) -> Result<(), Error> {
     let scene = scene_file::load(path)?;
     print!("{}", describe(&scene, &path.display().to_string()));
@@ -229,10 +378,14 @@ pub fn describe(scene: &Scene, name: &str) -> String {
     for role in [Role::Sphere, Role::Floor] {
         let objects: Vec<_> = scene.objects.iter().filter(|o| o.role == role).collect();
         let heading = match role {
-            Role::Sphere => "spheres",
-            Role::Floor => "planes (drawn from the plane stage on)",
+            Role::Sphere => "spheres:",
+            Role::Floor => "planes: ",
         };
-        out += &format!("  {} {heading}\n", objects.len());
+        let note = match role {
+            Role::Floor if !objects.is_empty() => " (drawn from the plane stage on)",
+            _ => "",
+        };
+        out += &format!("  {heading} {}{note}\n", objects.len());
         for (i, o) in objects.iter().enumerate() {
             let shape = match o.shape {
                 Shape::Sphere(sp) => format!("sphere at {}, radius {}", sp.center, sp.radius),

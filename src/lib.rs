@@ -39,6 +39,8 @@ pub mod aov;
 pub mod output;
 pub mod render;
 pub mod stages;
-// The command line and its errors.
+// The command line, its errors, and the tools around the renderer.
 pub mod cli;
+pub mod compare;
 pub mod error;
+pub mod figures;

@@ -9,15 +9,43 @@ use crate::aov::{FirstHit, Frame, PixelRecord};
 use crate::camera::Camera;
 use crate::ray::Ray;
 use crate::scene::{nearest_hit, Light, Object, Scene};
-use crate::shade::{blinn_phong, reflection, shadow};
+use crate::shade::blinn_phong::{self, Viewer};
+use crate::shade::reflection;
+use crate::shade::shadow::{self, Offset};
 use crate::stages::Stages;
 use crate::Vec3;
+
+/// How to render: the stages, and the few places where raystep can differ from the
+/// tutorial. `Settings::from(stages)` keeps the tutorial's rules.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// Which stages are on.
+    pub stages: Stages,
+    /// How far new rays start from a hit point (`--offset`; tutorial: `fixed:1e-5`).
+    pub offset: Offset,
+    /// Who views the highlight on a bounce (`--viewer`; tutorial: the camera).
+    pub viewer: Viewer,
+}
+
+impl From<Stages> for Settings {
+    fn from(stages: Stages) -> Settings {
+        Settings {
+            stages,
+            offset: Offset::default(),
+            viewer: Viewer::default(),
+        }
+    }
+}
 
 /// What the render needs to follow one ray: the scene reduced to what the enabled
 /// stages use.
 pub struct Tracer {
     /// The stages that are on.
     pub stages: Stages,
+    /// How far new rays start from a hit point.
+    pub offset: Offset,
+    /// Who views the highlight on a bounce.
+    pub viewer: Viewer,
     /// The camera: where primary rays start, and the viewer of Blinn-Phong.
     pub camera: Camera,
     /// The objects in play under `stages`.
@@ -38,12 +66,14 @@ pub struct Traced {
 }
 
 impl Tracer {
-    /// The tracer of `scene` under `stages`.
-    pub fn new(scene: &Scene, stages: Stages) -> Tracer {
+    /// The tracer of `scene` under `settings`.
+    pub fn new(scene: &Scene, settings: &Settings) -> Tracer {
         Tracer {
-            stages,
+            stages: settings.stages,
+            offset: settings.offset,
+            viewer: settings.viewer,
             camera: scene.camera(),
-            objects: scene.objects_in_play(stages),
+            objects: scene.objects_in_play(settings.stages),
             light: scene.light,
             max_depth: scene.max_depth,
         }
@@ -83,14 +113,16 @@ impl Tracer {
             let object = &self.objects[hit.object];
             let point = ray.at(hit.t);
             let normal = object.normal_at(point, &ray);
-            let shifted = shadow::step_off(point, normal);
+            let shifted = shadow::step_off(point, normal, self.offset);
             let to_light = (self.light.position - shifted).normalize();
 
+            // ANCHOR: shadow_test
             // Shadow: a point that does not see the light ends the path, black.
             let lit = !self.stages.shadow || {
                 let light_distance = self.light.position.distance(point);
                 !shadow::in_shadow(&self.objects, shifted, to_light, light_distance)
             };
+            // ANCHOR_END: shadow_test
             if segment == 0 {
                 first = Some(FirstHit {
                     depth: hit.t,
@@ -103,32 +135,41 @@ impl Tracer {
                 break;
             }
 
+            // ANCHOR: shading
             // Blinn-Phong, seen from the camera (on every bounce, as in the tutorial).
             let illumination = if self.stages.blinn_phong {
-                let to_viewer = (self.camera.position - point).normalize();
+                let viewer = match self.viewer {
+                    Viewer::Camera => self.camera.position,
+                    Viewer::RayOrigin => ray.origin,
+                };
+                let to_viewer = (viewer - point).normalize();
                 blinn_phong::illuminate(&object.material, &self.light, normal, to_light, to_viewer)
             } else {
                 object.material.diffuse
             };
 
+            // ANCHOR_END: shading
+            // ANCHOR: accumulate
             // Reflection: add this segment's light, weighted, and bounce.
             colour += weight * illumination;
             weight *= object.material.reflection;
             ray = reflection::reflected_ray(shifted, &ray, normal);
         }
+        // The pixel's colour: the sum, clipped to what a screen can show.
         Traced {
             colour: colour.clamp(Vec3::ZERO, Vec3::ONE),
             first,
         }
+        // ANCHOR_END: accumulate
     }
     // ANCHOR_END: trace
 }
 
 // ANCHOR: render
-/// Render `scene` under `stages`. `progress(1)` is called, from any thread, each
+/// Render `scene` under `settings`. `progress(1)` is called, from any thread, each
 /// time a row is finished.
-pub fn render(scene: &Scene, stages: Stages, progress: &(dyn Fn(u64) + Sync)) -> Frame {
-    let tracer = Tracer::new(scene, stages);
+pub fn render(scene: &Scene, settings: &Settings, progress: &(dyn Fn(u64) + Sync)) -> Frame {
+    let tracer = Tracer::new(scene, settings);
     let width = scene.width as usize;
     let mut pixels =
         vec![PixelRecord::new(Vec3::ZERO, Vec3::ZERO, None); width * scene.height as usize];
@@ -144,7 +185,7 @@ pub fn render(scene: &Scene, stages: Stages, progress: &(dyn Fn(u64) + Sync)) ->
     Frame {
         width: scene.width,
         height: scene.height,
-        has_surface_buffers: stages.intersection,
+        has_surface_buffers: settings.stages.intersection,
         pixels,
     }
 }

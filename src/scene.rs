@@ -99,6 +99,7 @@ impl Scene {
         }
     }
 
+    // ANCHOR: objects_in_play
     /// The objects that take part under `stages`: `[[plane]]` entries only from the
     /// `plane` stage on.
     pub fn objects_in_play(&self, stages: Stages) -> Vec<Object> {
@@ -108,6 +109,7 @@ impl Scene {
             .copied()
             .collect()
     }
+    // ANCHOR_END: objects_in_play
 }
 
 /// The nearest object a ray hits.

@@ -97,6 +97,17 @@ pub fn check_image_size(width: u32, height: u32, source: &str) -> Result<(), Str
     Ok(())
 }
 
+/// Refuse a `max_depth` outside 1 to [`MAX_DEPTH`], naming where it came from.
+pub fn check_max_depth(max_depth: u32, source: &str) -> Result<(), String> {
+    if (1..=MAX_DEPTH).contains(&max_depth) {
+        Ok(())
+    } else {
+        Err(format!(
+            "{source} = {max_depth}: must be from 1 to {MAX_DEPTH}"
+        ))
+    }
+}
+
 type Triple = [f64; 3];
 
 // ANCHOR: schema

@@ -131,9 +131,9 @@ fn check_describes_the_scene() {
         "a valid scene",
         "300 × 200",
         "max_depth 3",
-        "3 spheres",
+        "spheres: 3",
         "radius 8999.3",
-        "1 planes",
+        "planes:  1",
     ] {
         assert!(stdout.contains(expected), "{expected:?} in\n{stdout}");
     }
@@ -207,6 +207,10 @@ fn mistakes_end_in_one_clear_message_and_exit_code_2() {
         ("not UTF-8", Some(String::from_utf8_lossy(&[0xff, 0xfe, 0x00]).into_owned()), vec![], vec!["bad.toml"]),
         ("a stage without what it needs", Some(scene_with("")), vec!["--stage", "shadow", "--without", "intersection"], vec!["`shadow` cannot run without `intersection`"]),
         ("unknown stage", Some(scene_with("")), vec!["--stage", "shadows"], vec!["invalid value 'shadows'", "shadow"]),
+        ("offset without a kind", Some(scene_with("")), vec!["--offset", "1e-5"], vec!["--offset", "expected fixed:VALUE"]),
+        ("negative offset", Some(scene_with("")), vec!["--offset", "fixed:-1"], vec!["--offset", "0 or more"]),
+        ("max-depth flag 0", Some(scene_with("")), vec!["--max-depth", "0"], vec!["--max-depth = 0", "from 1 to 64"]),
+        ("unknown viewer", Some(scene_with("")), vec!["--viewer", "eye"], vec!["invalid value 'eye'", "ray-origin"]),
         ("output folder is a file", Some(scene_with("")), vec!["--out", "bad.toml"], vec!["bad.toml", "is a file"]),
         ("output folder inside a file", Some(scene_with("")), vec!["--out", "bad.toml/sub"], vec!["bad.toml/sub", "cannot create"]),
     ];
@@ -239,4 +243,53 @@ fn mistakes_end_in_one_clear_message_and_exit_code_2() {
             .collect();
         assert!(left.len() <= 1, "{what}: left {left:?}");
     }
+}
+
+#[test]
+fn diff_compares_two_renders_and_refuses_two_sizes() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |args: &[&str]| raystep(dir.path(), args);
+    assert!(
+        run(&["render", "--width", "60", "--height", "40", "--out", "a"])
+            .status
+            .success()
+    );
+    assert!(run(&[
+        "render",
+        "--width",
+        "60",
+        "--height",
+        "40",
+        "--viewer",
+        "ray-origin",
+        "--out",
+        "b"
+    ])
+    .status
+    .success());
+    assert!(
+        run(&["render", "--width", "30", "--height", "20", "--out", "small"])
+            .status
+            .success()
+    );
+
+    let same = run(&["diff", "a/buffers.exr", "a/buffers.exr"]);
+    assert!(same.status.success());
+    assert!(
+        text(&same.stdout).contains("differ by more than 1/255: 0 pixels (0.00 %)"),
+        "{}",
+        text(&same.stdout)
+    );
+
+    let other = run(&["diff", "a/buffers.exr", "b/buffers.exr"]);
+    assert!(other.status.success());
+    assert!(!text(&other.stdout).contains("differ by more than 1/255: 0 pixels"));
+
+    let sizes = run(&["diff", "a/buffers.exr", "small/buffers.exr"]);
+    assert_eq!(sizes.status.code(), Some(2));
+    assert!(text(&sizes.stderr).contains("60 × 40 but small/buffers.exr is 30 × 20"));
+
+    let not_exr = run(&["diff", "a/buffers.exr", "a/beauty.png"]);
+    assert_eq!(not_exr.status.code(), Some(2));
+    assert!(text(&not_exr.stderr).contains("a/beauty.png: cannot read it as an EXR file"));
 }

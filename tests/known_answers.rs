@@ -7,7 +7,8 @@ mod common;
 use raystep::output::{exr_bytes, png_bytes};
 use raystep::ray::Ray;
 use raystep::render::Tracer;
-use raystep::shade::{reflection::reflect, shadow::step_off};
+use raystep::shade::reflection::reflect;
+use raystep::shade::shadow::{step_off, Offset};
 use raystep::stages::{Stage, Stages};
 use raystep::Vec3;
 
@@ -47,7 +48,7 @@ fn every_depth_equals_the_geometric_distance_to_the_sphere() {
     // step back by the half chord.
     let mut scene = common::scene(ONE_SPHERE);
     (scene.width, scene.height) = (41, 41);
-    let tracer = Tracer::new(&scene, Stages::ALL);
+    let tracer = Tracer::new(&scene, &Stages::ALL.into());
     let (c, r) = (Vec3::new(0.0, 0.0, -3.0), 1.0);
     let mut hits = 0;
     for row in 0..41 {
@@ -152,21 +153,21 @@ fn a_point_behind_an_occluder_is_in_shadow_and_black() {
         origin: Vec3::new(0.0, 1.0, -2.0),
         direction: -Vec3::Y,
     };
-    let blocked = Tracer::new(&occluder_scene(0.0), Stages::ALL).trace(down);
+    let blocked = Tracer::new(&occluder_scene(0.0), &Stages::ALL.into()).trace(down);
     let hit = blocked.first.unwrap();
     assert_eq!(hit.depth, 1.0);
     assert!(!hit.lit);
     assert_eq!(blocked.colour, Vec3::ZERO);
 
     // The same point with the occluder moved aside is lit.
-    let open = Tracer::new(&occluder_scene(3.0), Stages::ALL).trace(down);
+    let open = Tracer::new(&occluder_scene(3.0), &Stages::ALL.into()).trace(down);
     assert!(open.first.unwrap().lit);
     assert!(open.colour.max_element() > 0.5);
 
     // Without the shadow stage no shadow ray is cast: the point reads lit.
     let no_shadow = Stages::select(Stage::Plane, &[Stage::Shadow]).unwrap();
     assert!(
-        Tracer::new(&occluder_scene(0.0), no_shadow)
+        Tracer::new(&occluder_scene(0.0), &no_shadow.into())
             .trace(down)
             .first
             .unwrap()
@@ -177,7 +178,7 @@ fn a_point_behind_an_occluder_is_in_shadow_and_black() {
 #[test]
 fn a_ray_recast_from_a_stepped_off_hit_point_does_not_hit_its_own_surface() {
     let scene = common::seed(150, 100);
-    let tracer = Tracer::new(&scene, Stages::ALL);
+    let tracer = Tracer::new(&scene, &Stages::ALL.into());
     let mut checked = 0;
     for row in 0..scene.height {
         for col in 0..scene.width {
@@ -187,7 +188,7 @@ fn a_ray_recast_from_a_stepped_off_hit_point_does_not_hit_its_own_surface() {
             };
             let object = &tracer.objects[hit.object];
             let point = ray.at(hit.depth);
-            let shifted = step_off(point, hit.normal);
+            let shifted = step_off(point, hit.normal, Offset::default());
             let to_light = (scene.light.position - shifted).normalize();
             let mut directions = vec![reflect(ray.direction, hit.normal)];
             if to_light.dot(hit.normal) > 0.0 {

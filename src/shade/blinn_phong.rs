@@ -3,6 +3,17 @@
 use crate::scene::{Light, Material};
 use crate::Vec3;
 
+/// Where the viewer of the highlight stands (`--viewer`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Viewer {
+    /// The camera, on every bounce: the tutorial's rule.
+    #[default]
+    Camera,
+    /// The origin of the ray that found the point: on a bounce, the surface it was
+    /// reflected from, which is where that light travels to.
+    RayOrigin,
+}
+
 // ANCHOR: illuminate
 /// The light a point reflects towards the viewer.
 ///

@@ -13,9 +13,9 @@ pub fn seed(width: u32, height: u32) -> Scene {
     scene
 }
 
-/// Render without progress reporting.
+/// Render with the tutorial's settings, without progress reporting.
 pub fn render(scene: &Scene, stages: Stages) -> Frame {
-    raystep::render::render(scene, stages, &|_| {})
+    raystep::render::render(scene, &stages.into(), &|_| {})
 }
 
 /// A scene from TOML text, which must be valid.

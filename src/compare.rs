@@ -1,0 +1,114 @@
+//! Comparing two renders: how many pixels differ, and by how much (`raystep diff`).
+
+use std::path::Path;
+
+use crate::error::Error;
+
+/// How two images of the same size differ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Difference {
+    /// Pixels compared.
+    pub pixels: usize,
+    /// Pixels where some channel differs by more than 1/255 (one 8-bit step).
+    pub over_one_step: usize,
+    /// The largest difference of any channel.
+    pub largest: f32,
+    /// Where it is: (row, column).
+    pub largest_at: (usize, usize),
+    /// Root mean square difference over every channel of every pixel.
+    pub rmse: f64,
+    /// Pixels with some channel at 1 or more (clipped), in each image.
+    pub saturated: (usize, usize),
+}
+
+/// Compare two RGB images of `width` columns, pixel by pixel.
+pub fn compare(a: &[[f32; 3]], b: &[[f32; 3]], width: usize) -> Difference {
+    assert_eq!(a.len(), b.len(), "images of one size");
+    let mut d = Difference {
+        pixels: a.len(),
+        over_one_step: 0,
+        largest: 0.0,
+        largest_at: (0, 0),
+        rmse: 0.0,
+        saturated: (0, 0),
+    };
+    let mut squares = 0.0f64;
+    for (i, (p, q)) in a.iter().zip(b).enumerate() {
+        let worst = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max);
+        squares += (0..3).map(|c| f64::from(p[c] - q[c]).powi(2)).sum::<f64>();
+        if worst > 1.0 / 255.0 {
+            d.over_one_step += 1;
+        }
+        if worst > d.largest {
+            d.largest = worst;
+            d.largest_at = (i / width, i % width);
+        }
+        d.saturated.0 += usize::from(p.iter().any(|&c| c >= 1.0));
+        d.saturated.1 += usize::from(q.iter().any(|&c| c >= 1.0));
+    }
+    d.rmse = (squares / (3 * a.len().max(1)) as f64).sqrt();
+    d
+}
+
+/// The beauty (`R`, `G`, `B`) of a `buffers.exr` file: width, height, pixels.
+pub fn read_beauty(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>), Error> {
+    let fail = |message: String| Error::Scene {
+        file: path.display().to_string(),
+        message,
+    };
+    let image = exr::prelude::read_all_flat_layers_from_file(path)
+        .map_err(|e| fail(format!("cannot read it as an EXR file: {e}")))?;
+    let layer = image
+        .layer_data
+        .first()
+        .ok_or_else(|| fail("has no image layer".into()))?;
+    let channel = |name: &str| {
+        layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name == *name)
+            .map(|c| c.sample_data.values_as_f32().collect::<Vec<f32>>())
+            .ok_or_else(|| {
+                fail(format!(
+                    "has no `{name}` channel; raystep's buffers.exr has R, G, B"
+                ))
+            })
+    };
+    let (r, g, b) = (channel("R")?, channel("G")?, channel("B")?);
+    let pixels = r
+        .iter()
+        .zip(&g)
+        .zip(&b)
+        .map(|((&r, &g), &b)| [r, g, b])
+        .collect();
+    Ok((layer.size.0, layer.size.1, pixels))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_differences_over_one_step_and_finds_the_largest() {
+        let a = [
+            [0.0, 0.0, 0.0],
+            [0.5, 0.5, 0.5],
+            [1.0, 0.2, 0.2],
+            [0.3, 0.3, 0.3],
+        ];
+        let b = [
+            [0.0, 0.0, 0.001],
+            [0.5, 0.6, 0.5],
+            [1.0, 0.2, 0.2],
+            [0.3, 0.3, 0.0],
+        ];
+        let d = compare(&a, &b, 2);
+        assert_eq!(d.over_one_step, 2);
+        assert!((d.largest - 0.3).abs() < 1e-6);
+        assert_eq!(d.largest_at, (1, 1));
+        assert_eq!(d.saturated, (1, 1));
+        let expected = ((0.001f64.powi(2) + 0.1f64.powi(2) + 0.3f64.powi(2)) / 12.0).sqrt();
+        assert!((d.rmse - expected).abs() < 1e-6, "{}", d.rmse);
+    }
+}

@@ -1,0 +1,217 @@
+//! The book's pictures. Every image in `chapters/img/` is listed here as the
+//! `raystep render` command a reader would type, and `raystep figures` runs those
+//! very commands, so the command printed beside a picture is the one that made it.
+//! `raystep figures --check` re-renders them all and compares the bytes.
+
+use std::path::{Path, PathBuf};
+
+use clap::Parser;
+
+use crate::aov::{Buffer, Frame};
+use crate::cli::{Cli, Command};
+use crate::error::Error;
+
+/// One picture of the book: `raystep ARGS`, keeping some of its buffers.
+#[derive(Clone, Copy, Debug)]
+pub struct Figure {
+    /// The path under `chapters/img/`, without `-buffer.png`, e.g. `ch04/acne`.
+    pub name: &'static str,
+    /// The arguments after `raystep`: always a `render` command.
+    pub args: &'static str,
+    /// The buffers kept, each written as `NAME-BUFFER.png`.
+    pub buffers: &'static [Buffer],
+}
+
+use Buffer::{Beauty, Depth, Normal, Shadow};
+
+/// Every figure of the book, by chapter.
+pub const FIGURES: &[Figure] = &[
+    fig("ch01/seed", "render scenes/seed.toml", &[Beauty]),
+    fig(
+        "ch02/rays",
+        "render scenes/seed.toml --stage rays",
+        &[Beauty],
+    ),
+    fig(
+        "ch02/narrow",
+        "render scenes/narrow.toml --stage rays",
+        &[Beauty],
+    ),
+    fig("ch02/narrow-plane", "render scenes/narrow.toml", &[Beauty]),
+    fig(
+        "ch03/intersection",
+        "render scenes/seed.toml --stage intersection",
+        &[Beauty, Depth, Normal, Shadow],
+    ),
+    fig(
+        "ch04/shadow",
+        "render scenes/seed.toml --stage shadow",
+        &[Beauty, Shadow],
+    ),
+    fig(
+        "ch04/acne",
+        "render scenes/seed.toml --stage shadow --offset fixed:0",
+        &[Beauty, Shadow],
+    ),
+    fig(
+        "ch04/blocker",
+        "render scenes/shadow.toml --stage shadow",
+        &[Beauty, Shadow],
+    ),
+    fig(
+        "ch05/blinn-phong",
+        "render scenes/seed.toml --stage blinn-phong",
+        &[Beauty],
+    ),
+    fig(
+        "ch05/no-shadow",
+        "render scenes/seed.toml --stage blinn-phong --without shadow",
+        &[Beauty],
+    ),
+    fig(
+        "ch05/highlights",
+        "render scenes/highlights.toml --stage blinn-phong",
+        &[Beauty],
+    ),
+    fig(
+        "ch06/reflection",
+        "render scenes/seed.toml --stage reflection",
+        &[Beauty],
+    ),
+    fig(
+        "ch06/mirrors-1",
+        "render scenes/mirrors.toml --stage reflection --max-depth 1",
+        &[Beauty],
+    ),
+    fig(
+        "ch06/mirrors-2",
+        "render scenes/mirrors.toml --stage reflection --max-depth 2",
+        &[Beauty],
+    ),
+    fig(
+        "ch06/mirrors-6",
+        "render scenes/mirrors.toml --stage reflection --max-depth 6",
+        &[Beauty],
+    ),
+    fig(
+        "ch07/fake",
+        "render scenes/seed.toml --stage plane",
+        &[Beauty, Depth, Normal, Shadow],
+    ),
+    fig(
+        "ch07/true",
+        "render scenes/true-plane.toml --stage plane",
+        &[Beauty, Depth, Normal, Shadow],
+    ),
+    fig("ch08/camera", "render --out out/camera", &[Beauty]),
+    fig(
+        "ch08/ray-origin",
+        "render --viewer ray-origin --out out/ray-origin",
+        &[Beauty],
+    ),
+];
+
+const fn fig(name: &'static str, args: &'static str, buffers: &'static [Buffer]) -> Figure {
+    Figure {
+        name,
+        args,
+        buffers,
+    }
+}
+
+impl Figure {
+    /// The file of one of its buffers, relative to `chapters/img/`.
+    pub fn file(&self, buffer: Buffer) -> String {
+        format!("{}-{}.png", self.name, buffer.name())
+    }
+
+    /// Render the figure; scene paths in `args` are relative to `root`. Returns each
+    /// kept buffer's file name and PNG bytes.
+    pub fn render(&self, root: &Path) -> Result<Vec<(String, Vec<u8>)>, Error> {
+        let frame = render_command(self.args, root)?;
+        Ok(self
+            .buffers
+            .iter()
+            .map(|&b| (self.file(b), crate::output::png_bytes(&frame, b)))
+            .collect())
+    }
+}
+
+/// The frame that `raystep ARGS` renders, for a `render` command; scene paths in
+/// `args` are relative to `root`.
+pub fn render_command(args: &str, root: &Path) -> Result<Frame, Error> {
+    let words = std::iter::once("raystep").chain(args.split_whitespace());
+    let cli =
+        Cli::try_parse_from(words).map_err(|e| Error::Usage(format!("`raystep {args}`: {e}")))?;
+    let Some(Command::Render(mut render)) = cli.command else {
+        return Err(Error::Usage(format!(
+            "`raystep {args}` is not a render command"
+        )));
+    };
+    render.scene.scene = render.scene.scene.map(|p| root.join(p));
+    let (scene, settings) = crate::cli::prepare(&render)?;
+    Ok(crate::render::render(&scene, &settings, &|_| {}))
+}
+
+/// Render every figure into `out` (normally `chapters/img`); scenes are read
+/// relative to `root`. Returns the files written.
+pub fn write_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>, Error> {
+    let mut written = Vec::new();
+    for figure in FIGURES {
+        for (file, bytes) in figure.render(root)? {
+            let path = out.join(file);
+            if let Some(dir) = path.parent() {
+                std::fs::create_dir_all(dir).map_err(|e| Error::Output {
+                    path: dir.to_path_buf(),
+                    message: e.to_string(),
+                })?;
+            }
+            crate::output::write_atomically(&path, &bytes)?;
+            written.push(path);
+        }
+    }
+    Ok(written)
+}
+
+/// Re-render every figure and compare with the files in `out`: the problems found
+/// (a missing file, different bytes, a PNG in `out` that no figure makes).
+pub fn check_all(root: &Path, out: &Path) -> Result<Vec<String>, Error> {
+    let mut problems = Vec::new();
+    let mut expected = Vec::new();
+    for figure in FIGURES {
+        for (file, bytes) in figure.render(root)? {
+            let path = out.join(&file);
+            match std::fs::read(&path) {
+                Err(_) => problems.push(format!("{file}: missing (raystep {})", figure.args)),
+                Ok(found) if found != bytes => problems.push(format!(
+                    "{file}: differs from what `raystep {}` renders now",
+                    figure.args
+                )),
+                Ok(_) => {}
+            }
+            expected.push(path);
+        }
+    }
+    for path in png_files(out) {
+        if !expected.contains(&path) {
+            problems.push(format!("{}: no figure makes this image", path.display()));
+        }
+    }
+    Ok(problems)
+}
+
+fn png_files(dir: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return found;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            found.extend(png_files(&path));
+        } else if path.extension().is_some_and(|e| e == "png") {
+            found.push(path);
+        }
+    }
+    found
+}
