@@ -1,6 +1,7 @@
 //! The camera and the screen rectangle it looks through: one primary ray per pixel.
 
 use crate::ray::Ray;
+use crate::real::{Real, Vector};
 use crate::Vec3;
 
 /// The screen: an axis-aligned rectangle in the plane `z = 0`.
@@ -47,28 +48,28 @@ pub struct Camera {
 // ANCHOR: primary_ray
 impl Camera {
     /// The point of the screen that pixel (`row` from the top, `col` from the left)
-    /// looks at. As in the tutorial, the first and last pixels sit exactly on the
-    /// screen's edges: `x = left + col·(right − left)/(W − 1)`.
-    pub fn screen_point(&self, row: u32, col: u32) -> Vec3 {
+    /// looks at, computed in precision `T`. As in the tutorial, the first and last
+    /// pixels sit exactly on the screen's edges: `x = left + col·(right − left)/(W − 1)`.
+    pub fn screen_point<T: Real>(&self, row: u32, col: u32) -> T::Vec3 {
         let s = &self.screen;
-        let x = lerp_on_grid(s.left, s.right, col, self.width);
-        let y = lerp_on_grid(s.top, s.bottom, row, self.height);
-        Vec3::new(x, y, 0.0)
+        let x = lerp_on_grid(T::of(s.left), T::of(s.right), col, self.width);
+        let y = lerp_on_grid(T::of(s.top), T::of(s.bottom), row, self.height);
+        T::Vec3::new(x, y, T::of(0.0))
     }
 
     /// The ray from the eye through the pixel's screen point.
-    pub fn primary_ray(&self, row: u32, col: u32) -> Ray {
-        Ray::towards(self.position, self.screen_point(row, col))
+    pub fn primary_ray<T: Real>(&self, row: u32, col: u32) -> Ray<T> {
+        Ray::towards(T::Vec3::of(self.position), self.screen_point::<T>(row, col))
     }
 }
 
 /// Sample `i` of `n` evenly spaced values from `from` to `to`, both ends included
 /// (numpy's `linspace`); a single sample sits in the middle.
-fn lerp_on_grid(from: f64, to: f64, i: u32, n: u32) -> f64 {
+fn lerp_on_grid<T: Real>(from: T, to: T, i: u32, n: u32) -> T {
     if n < 2 {
-        return 0.5 * (from + to);
+        return T::of(0.5) * (from + to);
     }
-    from + f64::from(i) * (to - from) / f64::from(n - 1)
+    from + T::of(f64::from(i)) * (to - from) / T::of(f64::from(n - 1))
 }
 // ANCHOR_END: primary_ray
 
@@ -88,14 +89,27 @@ mod tests {
     #[test]
     fn corner_pixels_sit_on_the_screen_corners() {
         let cam = camera(300, 200);
-        assert_eq!(cam.screen_point(0, 0), Vec3::new(-1.0, 2.0 / 3.0, 0.0));
-        assert_eq!(cam.screen_point(199, 299), Vec3::new(1.0, -2.0 / 3.0, 0.0));
+        assert_eq!(
+            cam.screen_point::<f64>(0, 0),
+            Vec3::new(-1.0, 2.0 / 3.0, 0.0)
+        );
+        assert_eq!(
+            cam.screen_point::<f64>(199, 299),
+            Vec3::new(1.0, -2.0 / 3.0, 0.0)
+        );
     }
 
     #[test]
     fn a_one_pixel_image_looks_at_the_screen_centre() {
         let cam = camera(1, 1);
-        assert_eq!(cam.screen_point(0, 0), Vec3::ZERO);
-        assert_eq!(cam.primary_ray(0, 0).direction, Vec3::new(0.0, 0.0, -1.0));
+        assert_eq!(cam.screen_point::<f64>(0, 0), Vec3::ZERO);
+        assert_eq!(
+            cam.primary_ray::<f64>(0, 0).direction,
+            Vec3::new(0.0, 0.0, -1.0)
+        );
+        assert_eq!(
+            cam.primary_ray::<f32>(0, 0).direction,
+            glam::Vec3::new(0.0, 0.0, -1.0)
+        );
     }
 }

@@ -8,12 +8,23 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::aov::Frame;
 use crate::error::Error;
+use crate::real::Precision;
 use crate::render::{render, Settings};
 use crate::scene::{Role, Scene, Shape};
 use crate::scene_file::{self, check_image_size, check_max_depth};
 use crate::shade::blinn_phong::Viewer;
 use crate::shade::shadow::Offset;
+use crate::sphere::Method;
 use crate::stages::{Stage, Stages};
+
+/// Print a line on stdout. A closed stdout (`raystep ... | head -1`) is not an
+/// error worth stopping a render for, and must not panic as `println!` does.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write;
+        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+    }};
+}
 
 /// raystep: a ray tracer that teaches ray tracing one step at a time.
 ///
@@ -55,13 +66,26 @@ pub struct SceneArgs {
     pub height: Option<u32>,
 }
 
-/// Where raystep may differ from the tutorial's rules; the defaults are the tutorial's.
+/// The choices of method the book compares. Unset ones keep raystep's defaults, or
+/// with `--tutorial` the tutorial's rules.
 #[derive(Args, Debug, Default)]
 pub struct RuleArgs {
+    /// The tutorial's program exactly: --precision f64 --intersect naive
+    /// --offset fixed:1e-5 (flags given beside it still apply).
+    #[arg(long)]
+    pub tutorial: bool,
+    /// Compute in float32 or float64 [default: f64].
+    #[arg(long, value_enum)]
+    pub precision: Option<Precision>,
+    /// How rays meet spheres: the tutorial's textbook quadratic (naive) or one that
+    /// does not cancel (stable) [default: stable].
+    #[arg(long, value_enum)]
+    pub intersect: Option<Method>,
     /// How far shadow and reflected rays start from a hit point, along the normal:
-    /// fixed:VALUE. The tutorial's is fixed:1e-5; fixed:0 shows shadow acne.
-    #[arg(long, default_value_t = Offset::default(), value_name = "fixed:VALUE")]
-    pub offset: Offset,
+    /// auto (a bound of the rounding error, right at every scale) or fixed:VALUE
+    /// (the tutorial's is fixed:1e-5; fixed:0 shows shadow acne) [default: auto].
+    #[arg(long, value_name = "auto|fixed:VALUE")]
+    pub offset: Option<Offset>,
     /// Who views the highlight on a reflection bounce: the camera (the tutorial's
     /// rule) or the ray's origin (the surface the light travels to).
     #[arg(long, value_enum, default_value_t = Viewer::Camera)]
@@ -161,9 +185,16 @@ impl RuleArgs {
             check_max_depth(depth, "--max-depth").map_err(Error::Usage)?;
             scene.max_depth = depth;
         }
+        let base = if self.tutorial {
+            Settings::tutorial(stages)
+        } else {
+            Settings::from(stages)
+        };
         Ok(Settings {
             stages,
-            offset: self.offset,
+            precision: self.precision.unwrap_or(base.precision),
+            method: self.intersect.unwrap_or(base.method),
+            offset: self.offset.unwrap_or(base.offset),
             viewer: self.viewer,
         })
     }
@@ -201,7 +232,7 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
     let (mut scene, name) = load_scene(&args.scene)?;
     let base = args.rules.apply(&mut scene, Stages::ALL)?;
     ensure_folder(&args.out)?;
-    println!("{name}: every stage at {} × {}", scene.width, scene.height);
+    say!("{name}: every stage at {} × {}", scene.width, scene.height);
     let bar = progress_bar(u64::from(scene.height) * Stage::ALL.len() as u64);
     let start = Instant::now();
     for stage in Stage::ALL {
@@ -215,7 +246,7 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
         write(&frame, &dir, seconds, &bar)?;
     }
     bar.finish_and_clear();
-    println!(
+    say!(
         "wrote {} stages into {}/ in {:.2} s",
         Stage::ALL.len(),
         args.out.display(),
@@ -228,9 +259,11 @@ fn render_one(args: RenderArgs) -> Result<(), Error> {
     let (scene, settings) = prepare(&args)?;
     ensure_folder(&args.out)?;
     let name = scene_name(&args.scene);
-    println!(
+    say!(
         "{name}: {} at {} × {}",
-        settings.stages, scene.width, scene.height
+        settings.stages,
+        scene.width,
+        scene.height
     );
     let bar = progress_bar(u64::from(scene.height));
     let (frame, seconds) = timed(|| render(&scene, &settings, &|n| bar.inc(n)));
@@ -245,7 +278,7 @@ fn write(frame: &Frame, dir: &Path, render_seconds: f64, bar: &ProgressBar) -> R
         .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
         .collect();
     bar.suspend(|| {
-        println!(
+        say!(
             "  {:<28} {}   render {:.3} s, write {:.3} s",
             format!("{}/", dir.display()),
             names.join(" "),
@@ -297,24 +330,27 @@ fn diff(args: &DiffArgs) -> Result<(), Error> {
         )));
     }
     let d = crate::compare::compare(&a, &b, wa);
-    println!(
+    say!(
         "{} against {}: {wa} × {ha} pixels",
         args.a.display(),
         args.b.display()
     );
-    println!(
+    say!(
         "  differ by more than 1/255: {} pixels ({:.2} %)",
         d.over_one_step,
         100.0 * d.over_one_step as f64 / d.pixels as f64
     );
-    println!(
+    say!(
         "  largest difference:        {:.4} (row {}, column {})",
-        d.largest, d.largest_at.0, d.largest_at.1
+        d.largest,
+        d.largest_at.0,
+        d.largest_at.1
     );
-    println!("  root mean square:          {:.6}", d.rmse);
-    println!(
+    say!("  root mean square:          {:.6}", d.rmse);
+    say!(
         "  clipped (a channel at 1):  {} and {} pixels",
-        d.saturated.0, d.saturated.1
+        d.saturated.0,
+        d.saturated.1
     );
     Ok(())
 }
@@ -324,7 +360,7 @@ fn figures(args: &FiguresArgs) -> Result<(), Error> {
     if args.check {
         let problems = crate::figures::check_all(root, &args.out)?;
         if problems.is_empty() {
-            println!(
+            say!(
                 "every figure in {} is what raystep renders now",
                 args.out.display()
             );
@@ -337,7 +373,7 @@ fn figures(args: &FiguresArgs) -> Result<(), Error> {
         )));
     }
     let written = crate::figures::write_all(root, &args.out)?;
-    println!(
+    say!(
         "wrote {} figures into {}/",
         written.len(),
         args.out.display()
@@ -347,7 +383,10 @@ fn figures(args: &FiguresArgs) -> Result<(), Error> {
 
 fn check(path: &Path) -> Result<(), Error> {
     let scene = scene_file::load(path)?;
-    print!("{}", describe(&scene, &path.display().to_string()));
+    say!(
+        "{}",
+        describe(&scene, &path.display().to_string()).trim_end()
+    );
     Ok(())
 }
 

@@ -28,6 +28,7 @@ pub mod scene;
 pub mod scene_file;
 // Chapter 2: rays.
 pub mod ray;
+pub mod real;
 // Chapter 3: intersection.
 pub mod sphere;
 // Chapters 4-6: shadow, Blinn-Phong, reflection.

@@ -3,34 +3,35 @@
 //! offers a true plane, a point and a normal, so the two can be compared.
 
 use crate::ray::Ray;
-use crate::Vec3;
+use crate::real::{Real, Vector};
 
 /// The points `X` with `⟨X − P, n⟩ = 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Plane {
+pub struct Plane<T: Real = f64> {
     /// Any point `P` of the plane.
-    pub point: Vec3,
+    pub point: T::Vec3,
     /// The unit normal `n`.
-    pub normal: Vec3,
+    pub normal: T::Vec3,
 }
 
 // ANCHOR: intersect
-impl Plane {
+impl<T: Real> Plane<T> {
     /// Distance along `ray` to the plane, if the ray crosses it in front of the
     /// origin: `t = ⟨P − O, n⟩ / ⟨d, n⟩`. A ray parallel to the plane misses.
-    pub fn intersect(&self, ray: &Ray) -> Option<f64> {
+    pub fn intersect(&self, ray: &Ray<T>) -> Option<T> {
+        let zero = T::of(0.0);
         let facing = ray.direction.dot(self.normal);
-        if facing == 0.0 {
+        if facing == zero {
             return None;
         }
         let t = (self.point - ray.origin).dot(self.normal) / facing;
-        (t > 0.0).then_some(t)
+        (t > zero).then_some(t)
     }
 
     /// The unit normal on the side the ray came from: a plane has two faces and
     /// both are lit the same way.
-    pub fn normal_towards(&self, ray: &Ray) -> Vec3 {
-        if ray.direction.dot(self.normal) > 0.0 {
+    pub fn normal_towards(&self, ray: &Ray<T>) -> T::Vec3 {
+        if ray.direction.dot(self.normal) > T::of(0.0) {
             -self.normal
         } else {
             self.normal
@@ -42,6 +43,7 @@ impl Plane {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Vec3;
 
     const FLOOR: Plane = Plane {
         point: Vec3::new(0.0, -1.0, 0.0),

@@ -1,23 +1,24 @@
 //! A ray: a starting point and a unit direction, `ray(t) = O + d·t`.
 
-use crate::Vec3;
+use crate::real::{Real, Vector};
 
-/// A half-line that starts at `origin` and runs along the unit vector `direction`.
+/// A half-line that starts at `origin` and runs along the unit vector `direction`,
+/// computed in precision `T` (float64 unless said otherwise).
 ///
 /// Because `direction` has length 1, the parameter `t` of [`Ray::at`] is also the
 /// distance from the origin: the depth buffer stores it as it is.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Ray {
+pub struct Ray<T: Real = f64> {
     /// Where the ray starts (`t = 0`).
-    pub origin: Vec3,
+    pub origin: T::Vec3,
     /// Unit vector the ray travels along.
-    pub direction: Vec3,
+    pub direction: T::Vec3,
 }
 
 // ANCHOR: ray
-impl Ray {
+impl<T: Real> Ray<T> {
     /// The ray that starts at `origin` and passes through `target`.
-    pub fn towards(origin: Vec3, target: Vec3) -> Ray {
+    pub fn towards(origin: T::Vec3, target: T::Vec3) -> Ray<T> {
         Ray {
             origin,
             direction: (target - origin).normalize(),
@@ -25,7 +26,7 @@ impl Ray {
     }
 
     /// The point at distance `t` along the ray: `O + d·t`.
-    pub fn at(&self, t: f64) -> Vec3 {
+    pub fn at(&self, t: T) -> T::Vec3 {
         self.origin + self.direction * t
     }
 }
@@ -34,10 +35,11 @@ impl Ray {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Vec3;
 
     #[test]
     fn towards_gives_a_unit_direction_and_at_walks_along_it() {
-        let ray = Ray::towards(Vec3::new(1.0, 2.0, 3.0), Vec3::new(1.0, 2.0, -7.0));
+        let ray: Ray = Ray::towards(Vec3::new(1.0, 2.0, 3.0), Vec3::new(1.0, 2.0, -7.0));
         assert_eq!(ray.direction, Vec3::new(0.0, 0.0, -1.0));
         assert_eq!(ray.at(0.0), ray.origin);
         assert_eq!(ray.at(2.5), Vec3::new(1.0, 2.0, 0.5));

@@ -8,22 +8,30 @@ use rayon::prelude::*;
 use crate::aov::{FirstHit, Frame, PixelRecord};
 use crate::camera::Camera;
 use crate::ray::Ray;
+use crate::real::{Precision, Real, Vector};
 use crate::scene::{nearest_hit, Light, Object, Scene};
 use crate::shade::blinn_phong::{self, Viewer};
 use crate::shade::reflection;
 use crate::shade::shadow::{self, Offset};
+use crate::sphere::Method;
 use crate::stages::Stages;
 use crate::Vec3;
 
-/// How to render: the stages, and the few places where raystep can differ from the
-/// tutorial. `Settings::from(stages)` keeps the tutorial's rules.
+/// How to render: the stages, and the choices of method that the book compares.
+/// `Settings::from(stages)` gives raystep's defaults; [`Settings::tutorial`] the
+/// tutorial's own rules.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Settings {
     /// Which stages are on.
     pub stages: Stages,
-    /// How far new rays start from a hit point (`--offset`; tutorial: `fixed:1e-5`).
+    /// The precision of every computation (`--precision`; default f64).
+    pub precision: Precision,
+    /// How rays meet spheres (`--intersect`; default stable, tutorial naive).
+    pub method: Method,
+    /// How far new rays start from a hit point (`--offset`; default auto, tutorial
+    /// `fixed:1e-5`).
     pub offset: Offset,
-    /// Who views the highlight on a bounce (`--viewer`; tutorial: the camera).
+    /// Who views the highlight on a bounce (`--viewer`; default and tutorial: the camera).
     pub viewer: Viewer,
 }
 
@@ -31,17 +39,35 @@ impl From<Stages> for Settings {
     fn from(stages: Stages) -> Settings {
         Settings {
             stages,
+            precision: Precision::default(),
+            method: Method::default(),
             offset: Offset::default(),
             viewer: Viewer::default(),
         }
     }
 }
 
-/// What the render needs to follow one ray: the scene reduced to what the enabled
-/// stages use.
-pub struct Tracer {
+impl Settings {
+    /// The tutorial's program exactly: float64, the textbook quadratic, the fixed
+    /// 1e-5 step, the camera as the viewer.
+    pub fn tutorial(stages: Stages) -> Settings {
+        Settings {
+            stages,
+            precision: Precision::F64,
+            method: Method::Naive,
+            offset: Offset::TUTORIAL,
+            viewer: Viewer::Camera,
+        }
+    }
+}
+
+/// What the render needs to follow one ray, in precision `T`: the scene reduced to
+/// what the enabled stages use.
+pub struct Tracer<T: Real = f64> {
     /// The stages that are on.
     pub stages: Stages,
+    /// How rays meet spheres.
+    pub method: Method,
     /// How far new rays start from a hit point.
     pub offset: Offset,
     /// Who views the highlight on a bounce.
@@ -49,9 +75,9 @@ pub struct Tracer {
     /// The camera: where primary rays start, and the viewer of Blinn-Phong.
     pub camera: Camera,
     /// The objects in play under `stages`.
-    pub objects: Vec<Object>,
+    pub objects: Vec<Object<T>>,
     /// The point light.
-    pub light: Light,
+    pub light: Light<T>,
     /// Most segments of a path, when the `reflection` stage is on.
     pub max_depth: u32,
 }
@@ -65,16 +91,18 @@ pub struct Traced {
     pub first: Option<FirstHit>,
 }
 
-impl Tracer {
-    /// The tracer of `scene` under `settings`.
-    pub fn new(scene: &Scene, settings: &Settings) -> Tracer {
+impl<T: Real> Tracer<T> {
+    /// The tracer of `scene` under `settings`, computing in `T` (the settings'
+    /// precision is for [`render`] to choose `T`).
+    pub fn new(scene: &Scene, settings: &Settings) -> Tracer<T> {
         Tracer {
             stages: settings.stages,
+            method: settings.method,
             offset: settings.offset,
             viewer: settings.viewer,
             camera: scene.camera(),
             objects: scene.objects_in_play(settings.stages),
-            light: scene.light,
+            light: scene.light.cast(),
             max_depth: scene.max_depth,
         }
     }
@@ -83,50 +111,57 @@ impl Tracer {
     /// The record of pixel (`row`, `col`). With only the `rays` stage on, the colour
     /// shows the ray's direction: each component mapped from [−1, 1] to [0, 1].
     pub fn pixel(&self, row: u32, col: u32) -> PixelRecord {
-        let ray = self.camera.primary_ray(row, col);
+        let ray = self.camera.primary_ray::<T>(row, col);
+        let direction = ray.direction.to_f64();
         if !self.stages.intersection {
-            let colour = (ray.direction + Vec3::ONE) * 0.5;
-            return PixelRecord::new(ray.direction, colour, None);
+            let colour = (direction + Vec3::ONE) * 0.5;
+            return PixelRecord::new(direction, colour, None);
         }
         let traced = self.trace(ray);
-        PixelRecord::new(ray.direction, traced.colour, traced.first)
+        PixelRecord::new(direction, traced.colour, traced.first)
     }
     // ANCHOR_END: pixel
 
     // ANCHOR: trace
     /// Follow a ray through the scene, as the tutorial's final program does.
-    pub fn trace(&self, primary: Ray) -> Traced {
+    pub fn trace(&self, primary: Ray<T>) -> Traced {
         let segments = if self.stages.reflection {
             self.max_depth
         } else {
             1
         };
-        let mut colour = Vec3::ZERO;
-        let mut weight = 1.0;
+        let mut colour = T::Vec3::ZERO;
+        let mut weight = T::of(1.0);
         let mut ray = primary;
         let mut first = None;
         for segment in 0..segments {
             // The nearest object along the ray; if there is none, the path ends.
-            let Some(hit) = nearest_hit(&self.objects, &ray) else {
+            let Some(hit) = nearest_hit(&self.objects, &ray, self.method) else {
                 break;
             };
             let object = &self.objects[hit.object];
             let point = ray.at(hit.t);
             let normal = object.normal_at(point, &ray);
-            let shifted = shadow::step_off(point, normal, self.offset);
+            let shifted = shadow::step_off(point, normal, object, self.offset);
             let to_light = (self.light.position - shifted).normalize();
 
             // ANCHOR: shadow_test
             // Shadow: a point that does not see the light ends the path, black.
             let lit = !self.stages.shadow || {
                 let light_distance = self.light.position.distance(point);
-                !shadow::in_shadow(&self.objects, shifted, to_light, light_distance)
+                !shadow::in_shadow(
+                    &self.objects,
+                    shifted,
+                    to_light,
+                    light_distance,
+                    self.method,
+                )
             };
             // ANCHOR_END: shadow_test
             if segment == 0 {
                 first = Some(FirstHit {
-                    depth: hit.t,
-                    normal,
+                    depth: hit.t.to_f64(),
+                    normal: normal.to_f64(),
                     lit,
                     object: hit.object,
                 });
@@ -139,7 +174,7 @@ impl Tracer {
             // Blinn-Phong, seen from the camera (on every bounce, as in the tutorial).
             let illumination = if self.stages.blinn_phong {
                 let viewer = match self.viewer {
-                    Viewer::Camera => self.camera.position,
+                    Viewer::Camera => T::Vec3::of(self.camera.position),
                     Viewer::RayOrigin => ray.origin,
                 };
                 let to_viewer = (viewer - point).normalize();
@@ -147,17 +182,16 @@ impl Tracer {
             } else {
                 object.material.diffuse
             };
-
             // ANCHOR_END: shading
             // ANCHOR: accumulate
             // Reflection: add this segment's light, weighted, and bounce.
-            colour += weight * illumination;
-            weight *= object.material.reflection;
+            colour += illumination * weight;
+            weight = weight * object.material.reflection;
             ray = reflection::reflected_ray(shifted, &ray, normal);
         }
         // The pixel's colour: the sum, clipped to what a screen can show.
         Traced {
-            colour: colour.clamp(Vec3::ZERO, Vec3::ONE),
+            colour: colour.clamp01().to_f64(),
             first,
         }
         // ANCHOR_END: accumulate
@@ -169,7 +203,19 @@ impl Tracer {
 /// Render `scene` under `settings`. `progress(1)` is called, from any thread, each
 /// time a row is finished.
 pub fn render(scene: &Scene, settings: &Settings, progress: &(dyn Fn(u64) + Sync)) -> Frame {
-    let tracer = Tracer::new(scene, settings);
+    match settings.precision {
+        Precision::F32 => render_in::<f32>(scene, settings, progress),
+        Precision::F64 => render_in::<f64>(scene, settings, progress),
+    }
+}
+
+/// [`render`], computing in `T`.
+pub fn render_in<T: Real>(
+    scene: &Scene,
+    settings: &Settings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Frame {
+    let tracer = Tracer::<T>::new(scene, settings);
     let width = scene.width as usize;
     let mut pixels =
         vec![PixelRecord::new(Vec3::ZERO, Vec3::ZERO, None); width * scene.height as usize];

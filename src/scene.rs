@@ -5,32 +5,33 @@
 use crate::camera::{Camera, Screen};
 use crate::plane::Plane;
 use crate::ray::Ray;
-use crate::sphere::Sphere;
+use crate::real::{Real, Vector};
+use crate::sphere::{Method, Sphere};
 use crate::stages::Stages;
 use crate::Vec3;
 
 /// How a surface answers light (the Blinn-Phong coefficients and the mirror weight).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Material {
+pub struct Material<T: Real = f64> {
     /// Colour under ambient light, `ka`.
-    pub ambient: Vec3,
+    pub ambient: T::Vec3,
     /// Colour under direct light, `kd`; also the flat colour of the `intersection` stage.
-    pub diffuse: Vec3,
+    pub diffuse: T::Vec3,
     /// Colour of the highlight, `ks`.
-    pub specular: Vec3,
+    pub specular: T::Vec3,
     /// How tight the highlight is; the exponent of `N·H` is `shininess / 4`.
-    pub shininess: f64,
+    pub shininess: T,
     /// Fraction of the reflected colour that is added, from 0 (matte) to 1 (mirror).
-    pub reflection: f64,
+    pub reflection: T,
 }
 
 /// The geometry of an object.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Shape {
+pub enum Shape<T: Real = f64> {
     /// A sphere (the tutorial's only shape; its fake plane is one too).
-    Sphere(Sphere),
+    Sphere(Sphere<T>),
     /// A true, infinite plane.
-    Plane(Plane),
+    Plane(Plane<T>),
 }
 
 /// Where an object came from in the scene file. Objects of `[[plane]]` entries are
@@ -45,26 +46,38 @@ pub enum Role {
 
 /// One thing in the scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Object {
+pub struct Object<T: Real = f64> {
     /// Its geometry.
-    pub shape: Shape,
+    pub shape: Shape<T>,
     /// Its surface.
-    pub material: Material,
+    pub material: Material<T>,
     /// Which scene-file section it came from.
     pub role: Role,
 }
 
 /// The point light: a position that shines equally in all directions.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Light {
+pub struct Light<T: Real = f64> {
     /// Where the light is.
-    pub position: Vec3,
+    pub position: T::Vec3,
     /// Its ambient colour, `la`.
-    pub ambient: Vec3,
+    pub ambient: T::Vec3,
     /// Its diffuse colour, `ld`.
-    pub diffuse: Vec3,
+    pub diffuse: T::Vec3,
     /// Its specular colour, `ls`.
-    pub specular: Vec3,
+    pub specular: T::Vec3,
+}
+
+impl Light {
+    /// The same light in precision `T`.
+    pub fn cast<T: Real>(&self) -> Light<T> {
+        Light {
+            position: T::Vec3::of(self.position),
+            ambient: T::Vec3::of(self.ambient),
+            diffuse: T::Vec3::of(self.diffuse),
+            specular: T::Vec3::of(self.specular),
+        }
+    }
 }
 
 /// Everything a scene file describes.
@@ -100,13 +113,13 @@ impl Scene {
     }
 
     // ANCHOR: objects_in_play
-    /// The objects that take part under `stages`: `[[plane]]` entries only from the
-    /// `plane` stage on.
-    pub fn objects_in_play(&self, stages: Stages) -> Vec<Object> {
+    /// The objects that take part under `stages`, in precision `T`: `[[plane]]`
+    /// entries only from the `plane` stage on.
+    pub fn objects_in_play<T: Real>(&self, stages: Stages) -> Vec<Object<T>> {
         self.objects
             .iter()
             .filter(|o| o.role == Role::Sphere || stages.plane)
-            .copied()
+            .map(Object::cast)
             .collect()
     }
     // ANCHOR_END: objects_in_play
@@ -114,25 +127,25 @@ impl Scene {
 
 /// The nearest object a ray hits.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hit {
+pub struct Hit<T: Real = f64> {
     /// Distance along the ray.
-    pub t: f64,
+    pub t: T,
     /// Index of the object in the slice that was searched.
     pub object: usize,
 }
 
 // ANCHOR: nearest_hit
-impl Object {
-    /// Distance along `ray` to this object, if it is hit.
-    pub fn intersect(&self, ray: &Ray) -> Option<f64> {
+impl<T: Real> Object<T> {
+    /// Distance along `ray` to this object, if it is hit (spheres by `method`).
+    pub fn intersect(&self, ray: &Ray<T>, method: Method) -> Option<T> {
         match &self.shape {
-            Shape::Sphere(s) => s.intersect(ray),
+            Shape::Sphere(s) => s.intersect(ray, method),
             Shape::Plane(p) => p.intersect(ray),
         }
     }
 
     /// The unit normal at the point `p` where `ray` hit this object.
-    pub fn normal_at(&self, p: Vec3, ray: &Ray) -> Vec3 {
+    pub fn normal_at(&self, p: T::Vec3, ray: &Ray<T>) -> T::Vec3 {
         match &self.shape {
             Shape::Sphere(s) => s.normal_at(p),
             Shape::Plane(pl) => pl.normal_towards(ray),
@@ -141,10 +154,10 @@ impl Object {
 }
 
 /// The first object along `ray`: test them all, keep the smallest distance.
-pub fn nearest_hit(objects: &[Object], ray: &Ray) -> Option<Hit> {
-    let mut nearest: Option<Hit> = None;
+pub fn nearest_hit<T: Real>(objects: &[Object<T>], ray: &Ray<T>, method: Method) -> Option<Hit<T>> {
+    let mut nearest: Option<Hit<T>> = None;
     for (index, object) in objects.iter().enumerate() {
-        if let Some(t) = object.intersect(ray) {
+        if let Some(t) = object.intersect(ray, method) {
             if nearest.is_none_or(|n| t < n.t) {
                 nearest = Some(Hit { t, object: index });
             }
@@ -155,9 +168,58 @@ pub fn nearest_hit(objects: &[Object], ray: &Ray) -> Option<Hit> {
 
 /// Is any object hit along `ray` closer than `distance`? The shadow test needs
 /// only a yes or a no, so it stops at the first blocker it finds.
-pub fn blocked(objects: &[Object], ray: &Ray, distance: f64) -> bool {
+pub fn blocked<T: Real>(objects: &[Object<T>], ray: &Ray<T>, distance: T, method: Method) -> bool {
     objects
         .iter()
-        .any(|o| o.intersect(ray).is_some_and(|t| t < distance))
+        .any(|o| o.intersect(ray, method).is_some_and(|t| t < distance))
 }
 // ANCHOR_END: nearest_hit
+
+impl<T: Real> Object<T> {
+    /// The point of the surface nearest to `p`, a point computed to be on it:
+    /// moved along the sphere's radius, or along the plane's normal.
+    pub fn project(&self, p: T::Vec3) -> T::Vec3 {
+        match &self.shape {
+            Shape::Sphere(s) => s.center + (p - s.center).normalize() * s.radius,
+            Shape::Plane(pl) => p - pl.normal * (p - pl.point).dot(pl.normal),
+        }
+    }
+
+    /// The size of the numbers this surface is computed from (the largest
+    /// coordinate of the centre plus the radius, or of the plane's point): rounding
+    /// errors of anything computed on it grow with this.
+    pub fn magnitude(&self) -> T {
+        match &self.shape {
+            Shape::Sphere(s) => s.center.max_abs() + s.radius,
+            Shape::Plane(pl) => pl.point.max_abs(),
+        }
+    }
+}
+
+impl Object {
+    /// The same object in precision `T`.
+    pub fn cast<T: Real>(&self) -> Object<T> {
+        let shape = match self.shape {
+            Shape::Sphere(s) => Shape::Sphere(Sphere {
+                center: T::Vec3::of(s.center),
+                radius: T::of(s.radius),
+            }),
+            Shape::Plane(p) => Shape::Plane(Plane {
+                point: T::Vec3::of(p.point),
+                normal: T::Vec3::of(p.normal),
+            }),
+        };
+        let m = &self.material;
+        Object {
+            shape,
+            material: Material {
+                ambient: T::Vec3::of(m.ambient),
+                diffuse: T::Vec3::of(m.diffuse),
+                specular: T::Vec3::of(m.specular),
+                shininess: T::of(m.shininess),
+                reflection: T::of(m.reflection),
+            },
+            role: self.role,
+        }
+    }
+}

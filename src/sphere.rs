@@ -1,53 +1,119 @@
-//! Ray-sphere intersection: the sphere equation, the quadratic and its discriminant.
+//! Ray-sphere intersection: the sphere equation, the quadratic and its
+//! discriminant, computed two ways, side by side: the tutorial's textbook formula
+//! and a careful one that keeps its accuracy where the textbook one loses it.
 
 use crate::ray::Ray;
-use crate::Vec3;
+use crate::real::{Real, Vector};
 
 /// The points `X` with `‖X − C‖² = r²`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Sphere {
+pub struct Sphere<T: Real = f64> {
     /// The centre `C`.
-    pub center: Vec3,
+    pub center: T::Vec3,
     /// The radius `r`, greater than 0.
-    pub radius: f64,
+    pub radius: T,
+}
+
+/// How the quadratic is solved (`--intersect`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum Method {
+    /// The tutorial's: `Δ = b² − 4c`, roots `(−b ± √Δ)/2`.
+    Naive,
+    /// Ray Tracing Gems, chapter 7: Δ from the ray's closest approach to the centre,
+    /// roots `q` and `c/q` (no subtraction of nearly equal numbers).
+    #[default]
+    Stable,
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Method::Naive => "naive",
+            Method::Stable => "stable",
+        })
+    }
 }
 
 // ANCHOR: intersect
-impl Sphere {
-    /// Distance along `ray` to where it enters the sphere, by the tutorial's rule.
-    ///
-    /// Putting `O + d·t` into the sphere equation gives `a·t² + b·t + c = 0` with
-    /// `a = ‖d‖² = 1`, `b = 2⟨d, O − C⟩`, `c = ‖O − C‖² − r²` and the discriminant
-    /// `Δ = b² − 4c`. Δ < 0: the ray misses; Δ = 0: it only touches the sphere,
-    /// which does not count; Δ > 0: two crossings. The sphere counts as hit only
-    /// when both roots are positive (it lies wholly in front of the origin), and the
+impl<T: Real> Sphere<T> {
+    /// Distance along `ray` to where it enters the sphere, by the tutorial's rule:
+    /// the sphere counts only when the ray crosses it twice (Δ > 0; a ray that only
+    /// touches it does not count) and both crossings are in front of the origin. The
     /// smaller root is the distance.
-    pub fn intersect(&self, ray: &Ray) -> Option<f64> {
-        let oc = ray.origin - self.center;
-        let b = 2.0 * ray.direction.dot(oc);
-        let c = oc.length_squared() - self.radius * self.radius;
-        let delta = b * b - 4.0 * c;
-        if delta > 0.0 {
-            let root = delta.sqrt();
-            let t1 = (-b + root) / 2.0;
-            let t2 = (-b - root) / 2.0;
-            if t1 > 0.0 && t2 > 0.0 {
-                return Some(t1.min(t2));
-            }
-        }
-        None
+    pub fn intersect(&self, ray: &Ray<T>, method: Method) -> Option<T> {
+        let (near, far) = match method {
+            Method::Naive => self.roots_naive(ray)?,
+            Method::Stable => self.roots_stable(ray)?,
+        };
+        let zero = T::of(0.0);
+        (near > zero && far > zero).then_some(near)
     }
 
     /// The outward unit normal at a point `p` on the surface.
-    pub fn normal_at(&self, p: Vec3) -> Vec3 {
+    pub fn normal_at(&self, p: T::Vec3) -> T::Vec3 {
         (p - self.center).normalize()
     }
 }
 // ANCHOR_END: intersect
 
+// ANCHOR: naive
+impl<T: Real> Sphere<T> {
+    /// The two roots of `t² + b·t + c = 0`, smaller first, if Δ > 0: the textbook
+    /// way. `b = 2⟨d, O − C⟩`, `c = ‖O − C‖² − r²`, `Δ = b² − 4c`, `t = (−b ± √Δ)/2`.
+    pub fn roots_naive(&self, ray: &Ray<T>) -> Option<(T, T)> {
+        let (two, four) = (T::of(2.0), T::of(4.0));
+        let oc = ray.origin - self.center;
+        let b = two * ray.direction.dot(oc);
+        let c = oc.length_squared() - self.radius * self.radius;
+        let delta = b * b - four * c;
+        if !(delta > T::of(0.0)) {
+            return None;
+        }
+        let root = delta.sqrt();
+        let t1 = (-b + root) / two;
+        let t2 = (-b - root) / two;
+        Some((t1.min(t2), t1.max(t2)))
+    }
+}
+// ANCHOR_END: naive
+
+// ANCHOR: stable
+impl<T: Real> Sphere<T> {
+    /// The same two roots, computed so that no step subtracts nearly equal numbers.
+    ///
+    /// With `f = O − C` and the half-coefficient `h = −⟨d, f⟩` (the distance along
+    /// the ray to the point closest to the centre), the roots are `h ± √(Δ/4)`, and
+    /// `Δ/4 = r² − ‖f + h·d‖²`: the radius squared minus the squared distance from
+    /// the centre to that closest point. The textbook `b² − 4c` computes the same
+    /// number as the difference of two large terms, which loses every digit when the
+    /// sphere is small or far compared with `‖f‖`.
+    ///
+    /// `q = h + sign(h)·√(Δ/4)` adds two numbers of one sign; the other root is
+    /// `c/q`, because the product of the roots is `c`.
+    pub fn roots_stable(&self, ray: &Ray<T>) -> Option<(T, T)> {
+        let f = ray.origin - self.center;
+        let h = -ray.direction.dot(f);
+        let closest = f + ray.direction * h;
+        let r2 = self.radius * self.radius;
+        let quarter_delta = r2 - closest.length_squared();
+        if !(quarter_delta > T::of(0.0)) {
+            return None;
+        }
+        let q = h + h.signum() * quarter_delta.sqrt();
+        if q == T::of(0.0) {
+            return None;
+        }
+        let c = f.length_squared() - r2;
+        let (t1, t2) = (c / q, q);
+        Some((t1.min(t2), t1.max(t2)))
+    }
+}
+// ANCHOR_END: stable
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Vec3;
 
     const UNIT: Sphere = Sphere {
         center: Vec3::new(0.0, 0.0, -5.0),
@@ -61,34 +127,90 @@ mod tests {
         }
     }
 
+    const METHODS: [Method; 2] = [Method::Naive, Method::Stable];
+
     #[test]
     fn a_ray_through_the_centre_hits_the_near_side() {
-        assert_eq!(UNIT.intersect(&ray([0.0; 3], [0.0, 0.0, -1.0])), Some(4.0));
+        for m in METHODS {
+            assert_eq!(
+                UNIT.intersect(&ray([0.0; 3], [0.0, 0.0, -1.0]), m),
+                Some(4.0),
+                "{m}"
+            );
+        }
     }
 
     #[test]
     fn a_ray_that_passes_beside_misses() {
-        assert_eq!(UNIT.intersect(&ray([0.0; 3], [0.0, 1.0, -1.0])), None);
+        for m in METHODS {
+            assert_eq!(
+                UNIT.intersect(&ray([0.0; 3], [0.0, 1.0, -1.0]), m),
+                None,
+                "{m}"
+            );
+        }
     }
 
     #[test]
     fn a_tangent_ray_does_not_count() {
         // Δ = 0 exactly: the ray grazes the top of the sphere at y = 1.
-        assert_eq!(
-            UNIT.intersect(&ray([0.0, 1.0, 0.0], [0.0, 0.0, -1.0])),
-            None
-        );
+        for m in METHODS {
+            assert_eq!(
+                UNIT.intersect(&ray([0.0, 1.0, 0.0], [0.0, 0.0, -1.0]), m),
+                None,
+                "{m}"
+            );
+        }
     }
 
     #[test]
     fn a_sphere_behind_or_around_the_origin_is_not_hit() {
-        // Behind: both roots negative.
-        assert_eq!(UNIT.intersect(&ray([0.0; 3], [0.0, 0.0, 1.0])), None);
-        // Around: one root negative, one positive (the tutorial's rule ignores it).
-        assert_eq!(
-            UNIT.intersect(&ray([0.0, 0.0, -5.0], [1.0, 0.0, 0.0])),
-            None
-        );
+        for m in METHODS {
+            // Behind: both roots negative.
+            assert_eq!(
+                UNIT.intersect(&ray([0.0; 3], [0.0, 0.0, 1.0]), m),
+                None,
+                "{m}"
+            );
+            // Around: one root negative, one positive (the tutorial's rule ignores it).
+            assert_eq!(
+                UNIT.intersect(&ray([0.0, 0.0, -5.0], [1.0, 0.0, 0.0]), m),
+                None,
+                "{m}"
+            );
+        }
+    }
+
+    #[test]
+    fn both_methods_give_both_roots() {
+        let r = ray([0.0, 0.5, 0.0], [0.0, 0.0, -1.0]);
+        let exact = (5.0 - 0.75f64.sqrt(), 5.0 + 0.75f64.sqrt());
+        for m in METHODS {
+            let (near, far) = match m {
+                Method::Naive => UNIT.roots_naive(&r),
+                Method::Stable => UNIT.roots_stable(&r),
+            }
+            .unwrap();
+            assert!(
+                (near - exact.0).abs() < 1e-14 && (far - exact.1).abs() < 1e-14,
+                "{m}"
+            );
+        }
+    }
+
+    #[test]
+    fn only_the_stable_method_sees_a_far_unit_sphere_in_float32() {
+        // A unit sphere 10,000 away, a ray aimed 0.5 off its centre: a sure hit.
+        let far: Sphere<f32> = Sphere {
+            center: glam::Vec3::new(0.0, 0.0, -10_000.0),
+            radius: 1.0,
+        };
+        let r: Ray<f32> = Ray::towards(glam::Vec3::ZERO, glam::Vec3::new(0.5, 0.0, -10_000.0));
+        let t = far.intersect(&r, Method::Stable).expect("stable: hit");
+        assert!((t - (10_000.0 - 0.75f32.sqrt())).abs() < 0.01, "{t}");
+        // b² and 4c are both about 4e8; float32 keeps 7 digits, so their difference,
+        // 4·(r² − 0.25) = 3, is lost in rounding.
+        assert_eq!(far.intersect(&r, Method::Naive), None);
     }
 
     #[test]

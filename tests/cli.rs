@@ -207,7 +207,7 @@ fn mistakes_end_in_one_clear_message_and_exit_code_2() {
         ("not UTF-8", Some(String::from_utf8_lossy(&[0xff, 0xfe, 0x00]).into_owned()), vec![], vec!["bad.toml"]),
         ("a stage without what it needs", Some(scene_with("")), vec!["--stage", "shadow", "--without", "intersection"], vec!["`shadow` cannot run without `intersection`"]),
         ("unknown stage", Some(scene_with("")), vec!["--stage", "shadows"], vec!["invalid value 'shadows'", "shadow"]),
-        ("offset without a kind", Some(scene_with("")), vec!["--offset", "1e-5"], vec!["--offset", "expected fixed:VALUE"]),
+        ("offset without a kind", Some(scene_with("")), vec!["--offset", "1e-5"], vec!["--offset", "expected auto or fixed:VALUE"]),
         ("negative offset", Some(scene_with("")), vec!["--offset", "fixed:-1"], vec!["--offset", "0 or more"]),
         ("max-depth flag 0", Some(scene_with("")), vec!["--max-depth", "0"], vec!["--max-depth = 0", "from 1 to 64"]),
         ("unknown viewer", Some(scene_with("")), vec!["--viewer", "eye"], vec!["invalid value 'eye'", "ray-origin"]),
@@ -292,4 +292,29 @@ fn diff_compares_two_renders_and_refuses_two_sizes() {
     let not_exr = run(&["diff", "a/buffers.exr", "a/beauty.png"]);
     assert_eq!(not_exr.status.code(), Some(2));
     assert!(text(&not_exr.stderr).contains("a/beauty.png: cannot read it as an EXR file"));
+}
+
+#[test]
+fn a_closed_stdout_is_not_a_crash() {
+    // `raystep check scene | head -1`: the reader goes away after one line.
+    use std::io::Read;
+    use std::process::Stdio;
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/seed.toml");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_raystep"))
+        .args(["check", scene])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take()); // close the pipe before raystep writes
+    let mut stderr = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut stderr)
+        .unwrap();
+    let status = child.wait().unwrap();
+    assert!(status.success(), "{status:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
 }

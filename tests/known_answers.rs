@@ -6,9 +6,10 @@ mod common;
 
 use raystep::output::{exr_bytes, png_bytes};
 use raystep::ray::Ray;
+use raystep::render::Settings;
 use raystep::render::Tracer;
 use raystep::shade::reflection::reflect;
-use raystep::shade::shadow::{step_off, Offset};
+use raystep::shade::shadow::step_off;
 use raystep::stages::{Stage, Stages};
 use raystep::Vec3;
 
@@ -48,12 +49,12 @@ fn every_depth_equals_the_geometric_distance_to_the_sphere() {
     // step back by the half chord.
     let mut scene = common::scene(ONE_SPHERE);
     (scene.width, scene.height) = (41, 41);
-    let tracer = Tracer::new(&scene, &Stages::ALL.into());
+    let tracer = Tracer::<f64>::new(&scene, &Stages::ALL.into());
     let (c, r) = (Vec3::new(0.0, 0.0, -3.0), 1.0);
     let mut hits = 0;
     for row in 0..41 {
         for col in 0..41 {
-            let ray = tracer.camera.primary_ray(row, col);
+            let ray = tracer.camera.primary_ray::<f64>(row, col);
             let along = (c - ray.origin).dot(ray.direction);
             let miss2 = (c - ray.origin).length_squared() - along * along;
             let traced = tracer.trace(ray);
@@ -149,25 +150,25 @@ fn occluder_scene(occluder_x: f64) -> raystep::scene::Scene {
 #[test]
 fn a_point_behind_an_occluder_is_in_shadow_and_black() {
     // Look straight down at the top of the lower sphere, (0, 0, -2).
-    let down = Ray {
+    let down: Ray = Ray {
         origin: Vec3::new(0.0, 1.0, -2.0),
         direction: -Vec3::Y,
     };
-    let blocked = Tracer::new(&occluder_scene(0.0), &Stages::ALL.into()).trace(down);
+    let blocked = Tracer::<f64>::new(&occluder_scene(0.0), &Stages::ALL.into()).trace(down);
     let hit = blocked.first.unwrap();
     assert_eq!(hit.depth, 1.0);
     assert!(!hit.lit);
     assert_eq!(blocked.colour, Vec3::ZERO);
 
     // The same point with the occluder moved aside is lit.
-    let open = Tracer::new(&occluder_scene(3.0), &Stages::ALL.into()).trace(down);
+    let open = Tracer::<f64>::new(&occluder_scene(3.0), &Stages::ALL.into()).trace(down);
     assert!(open.first.unwrap().lit);
     assert!(open.colour.max_element() > 0.5);
 
     // Without the shadow stage no shadow ray is cast: the point reads lit.
     let no_shadow = Stages::select(Stage::Plane, &[Stage::Shadow]).unwrap();
     assert!(
-        Tracer::new(&occluder_scene(0.0), &no_shadow.into())
+        Tracer::<f64>::new(&occluder_scene(0.0), &no_shadow.into())
             .trace(down)
             .first
             .unwrap()
@@ -177,34 +178,44 @@ fn a_point_behind_an_occluder_is_in_shadow_and_black() {
 
 #[test]
 fn a_ray_recast_from_a_stepped_off_hit_point_does_not_hit_its_own_surface() {
+    // With the tutorial's settings and with raystep's defaults: a ray that leaves
+    // the surface (reflected, or towards a light in front of it) never meets it.
     let scene = common::seed(150, 100);
-    let tracer = Tracer::new(&scene, &Stages::ALL.into());
-    let mut checked = 0;
-    for row in 0..scene.height {
-        for col in 0..scene.width {
-            let ray = tracer.camera.primary_ray(row, col);
-            let Some(hit) = tracer.trace(ray).first else {
-                continue;
-            };
-            let object = &tracer.objects[hit.object];
-            let point = ray.at(hit.depth);
-            let shifted = step_off(point, hit.normal, Offset::default());
-            let to_light = (scene.light.position - shifted).normalize();
-            let mut directions = vec![reflect(ray.direction, hit.normal)];
-            if to_light.dot(hit.normal) > 0.0 {
-                directions.push(to_light);
-            }
-            for direction in directions {
-                let again = object.intersect(&Ray {
-                    origin: shifted,
-                    direction,
-                });
-                assert_eq!(again, None, "pixel {row},{col} hits its own surface again");
-                checked += 1;
+    for settings in [Settings::tutorial(Stages::ALL), Settings::from(Stages::ALL)] {
+        let tracer = Tracer::<f64>::new(&scene, &settings);
+        let mut checked = 0;
+        for row in 0..scene.height {
+            for col in 0..scene.width {
+                let ray = tracer.camera.primary_ray::<f64>(row, col);
+                let Some(hit) = tracer.trace(ray).first else {
+                    continue;
+                };
+                let object = &tracer.objects[hit.object];
+                let point = ray.at(hit.depth);
+                let shifted = step_off(point, hit.normal, object, settings.offset);
+                let to_light = (scene.light.position - shifted).normalize();
+                let mut directions = vec![reflect::<f64>(ray.direction, hit.normal)];
+                if to_light.dot(hit.normal) > 0.0 {
+                    directions.push(to_light);
+                }
+                for direction in directions {
+                    let again = object.intersect(
+                        &Ray {
+                            origin: shifted,
+                            direction,
+                        },
+                        settings.method,
+                    );
+                    assert_eq!(
+                        again, None,
+                        "{settings:?}: pixel {row},{col} hits its own surface again"
+                    );
+                    checked += 1;
+                }
             }
         }
+        assert!(checked > 10_000, "{checked}");
     }
-    assert!(checked > 10_000, "{checked}");
 }
 
 #[test]

@@ -2,6 +2,7 @@
 
 mod common;
 
+use raystep::render::Settings;
 use raystep::stages::Stages;
 
 /// raystep computes in float64 like the tutorial's program and stores float32, as
@@ -16,7 +17,8 @@ const TOLERANCE: f32 = 1e-6;
 fn every_stage_on_reproduces_the_tutorials_figure_1() {
     let (w, h, reference) = common::read_pfm(include_bytes!("data/seed-300x200.pfm"));
     assert_eq!((w, h), (300, 200));
-    let frame = common::render(&common::seed(300, 200), Stages::ALL);
+    let settings = Settings::tutorial(Stages::ALL);
+    let frame = raystep::render::render(&common::seed(300, 200), &settings, &|_| {});
     let mut worst = (0.0f32, 0usize);
     for (i, (ours, theirs)) in frame.pixels.iter().zip(&reference).enumerate() {
         for (a, b) in ours.colour.iter().zip(theirs) {

@@ -1,7 +1,7 @@
 //! The Blinn-Phong reflection model: ambient + diffuse + specular.
 
+use crate::real::{Real, Vector};
 use crate::scene::{Light, Material};
-use crate::Vec3;
 
 /// Where the viewer of the highlight stands (`--viewer`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -27,17 +27,20 @@ pub enum Viewer {
 /// the light). `N·H` is clamped at 0 before the power: a negative base with a
 /// fractional exponent would give NaN, and on the tutorial's scene the clamp moves
 /// no pixel by more than 3e-12.
-pub fn illuminate(
-    material: &Material,
-    light: &Light,
-    normal: Vec3,
-    to_light: Vec3,
-    to_viewer: Vec3,
-) -> Vec3 {
+pub fn illuminate<T: Real>(
+    material: &Material<T>,
+    light: &Light<T>,
+    normal: T::Vec3,
+    to_light: T::Vec3,
+    to_viewer: T::Vec3,
+) -> T::Vec3 {
     let ambient = material.ambient * light.ambient;
     let diffuse = material.diffuse * light.diffuse * to_light.dot(normal);
     let half = (to_light + to_viewer).normalize();
-    let highlight = normal.dot(half).max(0.0).powf(material.shininess / 4.0);
+    let highlight = normal
+        .dot(half)
+        .max(T::of(0.0))
+        .powf(material.shininess / T::of(4.0));
     let specular = material.specular * light.specular * highlight;
     ambient + diffuse + specular
 }
@@ -46,6 +49,7 @@ pub fn illuminate(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Vec3;
 
     const WHITE: Light = Light {
         position: Vec3::ZERO,

@@ -1,0 +1,181 @@
+//! Float32 or float64: the tracer is written once, for any [`Real`].
+//!
+//! `Real` is the few operations the tracer needs from a number, and
+//! [`Vector`] the few it needs from a 3-vector; `f32` (with glam's `Vec3`) and
+//! `f64` (with glam's `DVec3`) provide them. Every type of the tracer takes the
+//! precision as a parameter that defaults to `f64`, so `Ray` means `Ray<f64>`.
+
+use std::fmt::Debug;
+use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
+
+use glam::DVec3;
+
+/// A floating-point number the tracer can compute in.
+pub trait Real:
+    Copy
+    + Debug
+    + PartialOrd
+    + Send
+    + Sync
+    + 'static
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// The 3-vector of this precision.
+    type Vec3: Vector<Self>;
+    /// The unit roundoff u: every basic operation is exact up to a factor (1 ± u).
+    const UNIT_ROUNDOFF: Self;
+    /// `f32` or `f64`.
+    const NAME: &'static str;
+    /// The number nearest to `x`.
+    fn of(x: f64) -> Self;
+    /// The same value in float64 (exact).
+    fn to_f64(self) -> f64;
+    /// Square root.
+    fn sqrt(self) -> Self;
+    /// Absolute value.
+    fn abs(self) -> Self;
+    /// `self` to the power `e`.
+    fn powf(self, e: Self) -> Self;
+    /// The larger of two.
+    fn max(self, other: Self) -> Self;
+    /// The smaller of two.
+    fn min(self, other: Self) -> Self;
+    /// 1 with the sign of `self` (+1 for +0).
+    fn signum(self) -> Self;
+}
+
+/// A 3-vector of [`Real`]s: a point, a direction or a colour.
+pub trait Vector<T>:
+    Copy
+    + Debug
+    + PartialEq
+    + Send
+    + Sync
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Neg<Output = Self>
+    + Mul<T, Output = Self>
+    + Mul<Self, Output = Self>
+    + AddAssign
+{
+    /// (0, 0, 0).
+    const ZERO: Self;
+    /// The vector (x, y, z).
+    fn new(x: T, y: T, z: T) -> Self;
+    /// Dot product.
+    fn dot(self, other: Self) -> T;
+    /// Euclidean length.
+    fn length(self) -> T;
+    /// Squared length.
+    fn length_squared(self) -> T;
+    /// The unit vector in the same direction.
+    fn normalize(self) -> Self;
+    /// Distance between two points.
+    fn distance(self, other: Self) -> T;
+    /// The largest absolute value of a component.
+    fn max_abs(self) -> T;
+    /// Each component clamped to [0, 1].
+    fn clamp01(self) -> Self;
+    /// The vector nearest to a float64 one.
+    fn of(v: DVec3) -> Self;
+    /// The same vector in float64 (exact).
+    fn to_f64(self) -> DVec3;
+}
+
+macro_rules! real {
+    ($t:ty, $v:ty, $name:literal) => {
+        impl Real for $t {
+            type Vec3 = $v;
+            const UNIT_ROUNDOFF: $t = <$t>::EPSILON / 2.0;
+            const NAME: &'static str = $name;
+            fn of(x: f64) -> $t {
+                x as $t
+            }
+            fn to_f64(self) -> f64 {
+                self as f64
+            }
+            fn sqrt(self) -> $t {
+                <$t>::sqrt(self)
+            }
+            fn abs(self) -> $t {
+                <$t>::abs(self)
+            }
+            fn powf(self, e: $t) -> $t {
+                <$t>::powf(self, e)
+            }
+            fn max(self, other: $t) -> $t {
+                <$t>::max(self, other)
+            }
+            fn min(self, other: $t) -> $t {
+                <$t>::min(self, other)
+            }
+            fn signum(self) -> $t {
+                if self >= 0.0 {
+                    1.0
+                } else {
+                    -1.0
+                }
+            }
+        }
+
+        impl Vector<$t> for $v {
+            const ZERO: $v = <$v>::ZERO;
+            fn new(x: $t, y: $t, z: $t) -> $v {
+                <$v>::new(x, y, z)
+            }
+            fn dot(self, other: $v) -> $t {
+                <$v>::dot(self, other)
+            }
+            fn length(self) -> $t {
+                <$v>::length(self)
+            }
+            fn length_squared(self) -> $t {
+                <$v>::length_squared(self)
+            }
+            fn normalize(self) -> $v {
+                <$v>::normalize(self)
+            }
+            fn distance(self, other: $v) -> $t {
+                <$v>::distance(self, other)
+            }
+            fn max_abs(self) -> $t {
+                self.abs().max_element()
+            }
+            fn clamp01(self) -> $v {
+                self.clamp(<$v>::ZERO, <$v>::ONE)
+            }
+            fn of(v: DVec3) -> $v {
+                <$v>::new(v.x as $t, v.y as $t, v.z as $t)
+            }
+            fn to_f64(self) -> DVec3 {
+                DVec3::new(self.x as f64, self.y as f64, self.z as f64)
+            }
+        }
+    };
+}
+
+real!(f32, glam::Vec3, "f32");
+real!(f64, glam::DVec3, "f64");
+
+/// Which [`Real`] a render computes in (`--precision`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum Precision {
+    /// float32: 24-bit significands, unit roundoff 6e-8.
+    F32,
+    /// float64: 53-bit significands, unit roundoff 1.1e-16 (the tutorial's, in Python).
+    #[default]
+    F64,
+}
+
+impl std::fmt::Display for Precision {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        })
+    }
+}
