@@ -63,11 +63,11 @@ impl Camera {
     }
 }
 
-/// Sample `i` of `n` evenly spaced values from `from` to `to`, both ends included
-/// (numpy's `linspace`); a single sample sits in the middle.
+/// Sample `i` of `n` evenly spaced values from `from` to `to`, both ends included,
+/// as numpy's `linspace` gives them (a single sample is `from`).
 fn lerp_on_grid<T: Real>(from: T, to: T, i: u32, n: u32) -> T {
     if n < 2 {
-        return T::of(0.5) * (from + to);
+        return from;
     }
     from + T::of(f64::from(i)) * (to - from) / T::of(f64::from(n - 1))
 }
@@ -100,16 +100,13 @@ mod tests {
     }
 
     #[test]
-    fn a_one_pixel_image_looks_at_the_screen_centre() {
+    fn a_one_pixel_image_looks_at_the_top_left_corner_as_linspace_does() {
+        // np.linspace(a, b, 1) is [a].
         let cam = camera(1, 1);
-        assert_eq!(cam.screen_point::<f64>(0, 0), Vec3::ZERO);
-        assert_eq!(
-            cam.primary_ray::<f64>(0, 0).direction,
-            Vec3::new(0.0, 0.0, -1.0)
-        );
-        assert_eq!(
-            cam.primary_ray::<f32>(0, 0).direction,
-            glam::Vec3::new(0.0, 0.0, -1.0)
-        );
+        assert_eq!(cam.screen_point::<f64>(0, 0), Vec3::new(-1.0, 1.0, 0.0));
+        let d = Vec3::new(-1.0, 1.0, -1.0).normalize();
+        assert!((cam.primary_ray::<f64>(0, 0).direction - d).length() < 1e-15);
+        let d32 = cam.primary_ray::<f32>(0, 0).direction;
+        assert!((glam::Vec3::new(-1.0, 1.0, -1.0).normalize() - d32).length() < 1e-6);
     }
 }

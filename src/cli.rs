@@ -11,7 +11,7 @@ use crate::error::Error;
 use crate::real::Precision;
 use crate::render::{render, Settings};
 use crate::scene::{Role, Scene, Shape};
-use crate::scene_file::{self, check_image_size, check_max_depth};
+use crate::scene_file::{self, check_max_depth, SizeOverride};
 use crate::shade::blinn_phong::Viewer;
 use crate::shade::shadow::Offset;
 use crate::sphere::Method;
@@ -51,6 +51,21 @@ pub enum Command {
     Diff(DiffArgs),
     /// Render the book's figures into chapters/img (run from the repository's root).
     Figures(FiguresArgs),
+    /// Measure every stress scene × precision × intersection method × offset against
+    /// a careful float64 reference: false hits and misses, hit points off the
+    /// surface, stepped-off origins still inside it, wrong shadows.
+    Accuracy(AccuracyArgs),
+}
+
+/// Arguments of `raystep accuracy`.
+#[derive(Args, Debug)]
+pub struct AccuracyArgs {
+    /// Only this stress case (a name from scenes/stress/, e.g. far-sphere).
+    #[arg(long)]
+    pub case: Option<String>,
+    /// Print one JSON array of objects instead of a table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// The scene to render and its size.
@@ -165,6 +180,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Some(Command::Check(args)) => check(&args.scene),
         Some(Command::Diff(args)) => diff(&args),
         Some(Command::Figures(args)) => figures(&args),
+        Some(Command::Accuracy(args)) => accuracy(&args),
     }
 }
 
@@ -217,15 +233,15 @@ fn scene_name(args: &SceneArgs) -> String {
 
 /// Load the scene named by `args` (or the built-in one) and apply the size flags.
 pub fn load_scene(args: &SceneArgs) -> Result<(Scene, String), Error> {
-    let mut scene = match &args.scene {
-        Some(path) => scene_file::load(path)?,
-        None => scene_file::seed(),
+    let size = SizeOverride {
+        width: args.width,
+        height: args.height,
     };
-    let name = scene_name(args);
-    scene.width = args.width.unwrap_or(scene.width);
-    scene.height = args.height.unwrap_or(scene.height);
-    check_image_size(scene.width, scene.height, "--").map_err(Error::Usage)?;
-    Ok((scene, name))
+    let scene = match &args.scene {
+        Some(path) => scene_file::load_sized(path, size)?,
+        None => scene_file::parse_sized(scene_file::SEED_TOML, scene_file::SEED_NAME, size)?,
+    };
+    Ok((scene, scene_name(args)))
 }
 
 fn stages(args: StagesArgs) -> Result<(), Error> {
@@ -352,6 +368,35 @@ fn diff(args: &DiffArgs) -> Result<(), Error> {
         d.saturated.0,
         d.saturated.1
     );
+    Ok(())
+}
+
+fn accuracy(args: &AccuracyArgs) -> Result<(), Error> {
+    use crate::accuracy::{measure_all, CASES};
+    if let Some(case) = &args.case {
+        if !CASES.iter().any(|(n, _)| n == case) {
+            let names: Vec<&str> = CASES.iter().map(|(n, _)| *n).collect();
+            return Err(Error::Usage(format!(
+                "--case {case}: no such stress case; the cases are {}",
+                names.join(", ")
+            )));
+        }
+    }
+    let rows: Vec<_> = measure_all()
+        .into_iter()
+        .filter(|m| args.case.as_ref().is_none_or(|c| &m.case == c))
+        .collect();
+    if args.json {
+        say!(
+            "{}",
+            serde_json::to_string_pretty(&rows).expect("plain data serialises")
+        );
+        return Ok(());
+    }
+    say!("{}", crate::accuracy::table_header());
+    for m in &rows {
+        say!("{}", crate::accuracy::table_row(m));
+    }
     Ok(())
 }
 

@@ -25,90 +25,38 @@ pub struct Figure {
 use Buffer::{Beauty, Depth, Normal, Shadow};
 
 /// Every figure of the book, by chapter.
+#[rustfmt::skip]
 pub const FIGURES: &[Figure] = &[
     fig("ch01/seed", "render scenes/seed.toml", &[Beauty]),
-    fig(
-        "ch02/rays",
-        "render scenes/seed.toml --stage rays",
-        &[Beauty],
-    ),
-    fig(
-        "ch02/narrow",
-        "render scenes/narrow.toml --stage rays",
-        &[Beauty],
-    ),
+    fig("ch02/rays", "render scenes/seed.toml --stage rays", &[Beauty]),
+    fig("ch02/narrow", "render scenes/narrow.toml --stage rays", &[Beauty]),
     fig("ch02/narrow-plane", "render scenes/narrow.toml", &[Beauty]),
-    fig(
-        "ch03/intersection",
-        "render scenes/seed.toml --stage intersection",
-        &[Beauty, Depth, Normal, Shadow],
-    ),
-    fig(
-        "ch04/shadow",
-        "render scenes/seed.toml --stage shadow",
-        &[Beauty, Shadow],
-    ),
-    fig(
-        "ch04/acne",
-        "render scenes/seed.toml --stage shadow --offset fixed:0",
-        &[Beauty, Shadow],
-    ),
-    fig(
-        "ch04/blocker",
-        "render scenes/shadow.toml --stage shadow",
-        &[Beauty, Shadow],
-    ),
-    fig(
-        "ch05/blinn-phong",
-        "render scenes/seed.toml --stage blinn-phong",
-        &[Beauty],
-    ),
-    fig(
-        "ch05/no-shadow",
-        "render scenes/seed.toml --stage blinn-phong --without shadow",
-        &[Beauty],
-    ),
-    fig(
-        "ch05/highlights",
-        "render scenes/highlights.toml --stage blinn-phong",
-        &[Beauty],
-    ),
-    fig(
-        "ch06/reflection",
-        "render scenes/seed.toml --stage reflection",
-        &[Beauty],
-    ),
-    fig(
-        "ch06/mirrors-1",
-        "render scenes/mirrors.toml --stage reflection --max-depth 1",
-        &[Beauty],
-    ),
-    fig(
-        "ch06/mirrors-2",
-        "render scenes/mirrors.toml --stage reflection --max-depth 2",
-        &[Beauty],
-    ),
-    fig(
-        "ch06/mirrors-6",
-        "render scenes/mirrors.toml --stage reflection --max-depth 6",
-        &[Beauty],
-    ),
-    fig(
-        "ch07/fake",
-        "render scenes/seed.toml --stage plane",
-        &[Beauty, Depth, Normal, Shadow],
-    ),
-    fig(
-        "ch07/true",
-        "render scenes/true-plane.toml --stage plane",
-        &[Beauty, Depth, Normal, Shadow],
-    ),
-    fig("ch08/camera", "render --out out/camera", &[Beauty]),
-    fig(
-        "ch08/ray-origin",
-        "render --viewer ray-origin --out out/ray-origin",
-        &[Beauty],
-    ),
+    fig("ch03/intersection", "render scenes/seed.toml --stage intersection", &[Beauty, Depth, Normal, Shadow]),
+    fig("ch04/shadow", "render scenes/seed.toml --stage shadow --offset fixed:1e-5", &[Beauty, Shadow]),
+    fig("ch04/acne", "render scenes/seed.toml --stage shadow --offset fixed:0", &[Beauty, Shadow]),
+    fig("ch04/blocker", "render scenes/shadow.toml --stage shadow", &[Beauty, Shadow]),
+    fig("ch05/blinn-phong", "render scenes/seed.toml --stage blinn-phong", &[Beauty]),
+    fig("ch05/no-shadow", "render scenes/seed.toml --stage blinn-phong --without shadow", &[Beauty]),
+    fig("ch05/highlights", "render scenes/highlights.toml --stage blinn-phong", &[Beauty]),
+    fig("ch06/reflection", "render scenes/seed.toml --stage reflection", &[Beauty]),
+    fig("ch06/mirrors-1", "render scenes/mirrors.toml --stage reflection --max-depth 1", &[Beauty]),
+    fig("ch06/mirrors-2", "render scenes/mirrors.toml --stage reflection --max-depth 2", &[Beauty]),
+    fig("ch06/mirrors-6", "render scenes/mirrors.toml --stage reflection --max-depth 6", &[Beauty]),
+    fig("ch07/fake", "render scenes/seed.toml --stage plane", &[Beauty, Depth, Normal, Shadow]),
+    fig("ch07/true", "render scenes/true-plane.toml --stage plane", &[Beauty, Depth, Normal, Shadow]),
+    fig("ch08/camera", "render --tutorial --out out/camera", &[Beauty]),
+    fig("ch08/ray-origin", "render --tutorial --viewer ray-origin --out out/ray-origin", &[Beauty]),
+    fig("ch09/far-naive", "render scenes/stress/far-sphere.toml --precision f32 --intersect naive", &[Beauty]),
+    fig("ch09/far-stable", "render scenes/stress/far-sphere.toml --precision f32", &[Beauty]),
+    fig("ch09/graze-naive", "render scenes/stress/graze.toml --precision f32 --intersect naive", &[Beauty]),
+    fig("ch09/graze-stable", "render scenes/stress/graze.toml --precision f32", &[Beauty]),
+    fig("ch09/x1000-tutorial", "render scenes/stress/seed-x1000.toml --precision f32 --tutorial", &[Shadow]),
+    fig("ch09/x1000-auto", "render scenes/stress/seed-x1000.toml --precision f32", &[Shadow]),
+    fig("ch09/tiny-tutorial", "render scenes/stress/tiny-sphere.toml --tutorial", &[Beauty, Shadow]),
+    fig("ch09/tiny-auto", "render scenes/stress/tiny-sphere.toml", &[Beauty, Shadow]),
+    fig("ch09/x0001-tutorial", "render scenes/stress/seed-x0.001.toml --tutorial", &[Shadow]),
+    fig("ch09/x0001-auto", "render scenes/stress/seed-x0.001.toml", &[Shadow]),
+    fig("ch09/contact", "render scenes/stress/contact.toml", &[Beauty]),
 ];
 
 const fn fig(name: &'static str, args: &'static str, buffers: &'static [Buffer]) -> Figure {

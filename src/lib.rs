@@ -41,6 +41,7 @@ pub mod output;
 pub mod render;
 pub mod stages;
 // The command line, its errors, and the tools around the renderer.
+pub mod accuracy;
 pub mod cli;
 pub mod compare;
 pub mod error;

@@ -31,9 +31,11 @@ pub fn owned_files() -> Vec<String> {
 }
 
 /// Write `frame` into the folder `dir` (created if needed): one PNG per buffer and
-/// [`EXR_FILE`]. Buffer files of an earlier render that this frame does not have
-/// (say `depth.png` after a `rays`-only render) are removed, so the folder never
-/// mixes two renders. Returns the files written.
+/// [`EXR_FILE`]. All of them are encoded and written to temporary names before any
+/// is renamed into place, and buffer files of an earlier render that this frame
+/// does not have (say `depth.png` after a `rays`-only render) are removed. A write
+/// that fails leaves the earlier render's files as they were. Returns the files
+/// written.
 pub fn write_frame(frame: &Frame, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     fs::create_dir_all(dir).map_err(|e| Error::Output {
         path: dir.to_path_buf(),
@@ -50,15 +52,13 @@ pub fn write_frame(frame: &Frame, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         },
         || exr_bytes(frame),
     );
-    let mut written = Vec::new();
-    for (buffer, bytes) in buffers.iter().zip(pngs) {
-        let path = dir.join(format!("{}.png", buffer.name()));
-        write_atomically(&path, &bytes)?;
-        written.push(path);
-    }
-    let path = dir.join(EXR_FILE);
-    write_atomically(&path, &exr?)?;
-    written.push(path);
+    let mut files: Vec<(PathBuf, Vec<u8>)> = buffers
+        .iter()
+        .zip(pngs)
+        .map(|(b, bytes)| (dir.join(format!("{}.png", b.name())), bytes))
+        .collect();
+    files.push((dir.join(EXR_FILE), exr?));
+    write_all_atomically(&files)?;
     for buffer in Buffer::ALL
         .into_iter()
         .filter(|b| !b.written(frame.has_surface_buffers))
@@ -71,25 +71,45 @@ pub fn write_frame(frame: &Frame, dir: &Path) -> Result<Vec<PathBuf>, Error> {
             })?;
         }
     }
-    Ok(written)
+    Ok(files.into_iter().map(|(path, _)| path).collect())
+}
+
+/// Write several files: every one to a temporary name in its folder first, and only
+/// when all are complete, rename them into place. A failure removes the temporary
+/// files and leaves the old ones as they were (a failure among the renames, which
+/// do not fail on a working disk, may leave some files renamed).
+pub fn write_all_atomically(files: &[(PathBuf, Vec<u8>)]) -> Result<(), Error> {
+    let temporaries: Vec<PathBuf> = files.iter().map(|(path, _)| temporary_name(path)).collect();
+    let fail = |path: &Path, e: std::io::Error| {
+        for t in &temporaries {
+            let _ = fs::remove_file(t);
+        }
+        Error::Output {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        }
+    };
+    for ((path, bytes), temporary) in files.iter().zip(&temporaries) {
+        fs::write(temporary, bytes).map_err(|e| fail(path, e))?;
+    }
+    for ((path, _), temporary) in files.iter().zip(&temporaries) {
+        fs::rename(temporary, path).map_err(|e| fail(path, e))?;
+    }
+    Ok(())
 }
 
 /// Write `bytes` to `path` through a temporary file in the same folder, renamed
 /// into place once complete.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    write_all_atomically(&[(path.to_path_buf(), bytes.to_vec())])
+}
+
+fn temporary_name(path: &Path) -> PathBuf {
     let name = path
         .file_name()
         .and_then(|n| n.to_str())
         .unwrap_or("output");
-    let temporary = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    let result = fs::write(&temporary, bytes).and_then(|()| fs::rename(&temporary, path));
-    result.map_err(|e| {
-        let _ = fs::remove_file(&temporary);
-        Error::Output {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        }
-    })
+    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
 // ANCHOR: visualise

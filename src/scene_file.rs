@@ -25,14 +25,33 @@ pub const SEED_NAME: &str = "scenes/seed.toml (built in)";
 /// Largest accepted image side, in pixels.
 pub const MAX_SIDE: u32 = 16384;
 
-/// Largest accepted image, in pixels (keeps the buffers under about 2.5 GiB).
-pub const MAX_PIXELS: u64 = 50_000_000;
+/// Largest accepted image, in pixels: 7680 × 4320 (8K). A render peaks at about
+/// [`PEAK_BYTES_PER_PIXEL`], so this one needs about 4 GB.
+pub const MAX_PIXELS: u64 = 7680 * 4320;
+
+/// Peak memory of a render and its files per pixel, measured: an 8000 × 6000
+/// render peaked at 5.6 GB resident (`/usr/bin/time -v raystep render --width 8000
+/// --height 6000`).
+pub const PEAK_BYTES_PER_PIXEL: u64 = 120;
+
+/// Largest magnitude accepted for any number in a scene: squares of coordinates
+/// stay far inside float32's and float64's range.
+pub const MAX_MAGNITUDE: f64 = 1e15;
 
 /// Largest accepted `max_depth`.
 pub const MAX_DEPTH: u32 = 64;
 
 /// Largest scene file read, in bytes.
 pub const MAX_FILE_BYTES: u64 = 16 * 1024 * 1024;
+
+/// An image size from the command line, overriding the scene's `[image]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SizeOverride {
+    /// `--width`.
+    pub width: Option<u32>,
+    /// `--height`.
+    pub height: Option<u32>,
+}
 
 /// The built-in figure-1 scene.
 pub fn seed() -> Scene {
@@ -41,57 +60,82 @@ pub fn seed() -> Scene {
 
 /// Read and check the scene file at `path`.
 pub fn load(path: &Path) -> Result<Scene, Error> {
+    load_sized(path, SizeOverride::default())
+}
+
+/// Read and check the scene file at `path`, at the size `size` asks for.
+pub fn load_sized(path: &Path, size: SizeOverride) -> Result<Scene, Error> {
     let file = path.display().to_string();
     let fail = |message: String| Error::Scene {
         file: file.clone(),
         message,
     };
-    let meta =
-        std::fs::metadata(path).map_err(|e| fail(format!("cannot read the scene file: {e}")))?;
+    let cannot = |e: std::io::Error| fail(format!("cannot read the scene file: {e}"));
+    let meta = std::fs::metadata(path).map_err(cannot)?;
     if meta.is_dir() {
         return Err(fail(
             "is a folder; give the path of a .toml scene file".into(),
         ));
     }
-    if meta.len() > MAX_FILE_BYTES {
+    // Read at most one byte past the limit: a device such as /dev/zero has no
+    // length to check beforehand.
+    let mut bytes = Vec::new();
+    let file_handle = std::fs::File::open(path).map_err(cannot)?;
+    std::io::Read::read_to_end(
+        &mut std::io::Read::take(file_handle, MAX_FILE_BYTES + 1),
+        &mut bytes,
+    )
+    .map_err(cannot)?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
         return Err(fail(format!(
-            "is {} bytes; a scene file may be at most {MAX_FILE_BYTES} bytes",
-            meta.len()
+            "is larger than {MAX_FILE_BYTES} bytes, the most a scene file may be"
         )));
     }
-    let bytes =
-        std::fs::read(path).map_err(|e| fail(format!("cannot read the scene file: {e}")))?;
     let text = String::from_utf8(bytes)
         .map_err(|_| fail("is not a text file (not UTF-8); a scene file is TOML text".into()))?;
-    parse(&text, &file)
+    parse_sized(&text, &file, size)
 }
 
 /// Check the TOML text of a scene; `file` names it in error messages.
 pub fn parse(text: &str, file: &str) -> Result<Scene, Error> {
+    parse_sized(text, file, SizeOverride::default())
+}
+
+/// Check the TOML text of a scene at the size `size` asks for (the size decides the
+/// default screen, so it is settled before anything is checked).
+pub fn parse_sized(text: &str, file: &str, size: SizeOverride) -> Result<Scene, Error> {
     let fail = |message: String| Error::Scene {
         file: file.to_string(),
         message,
     };
     let raw: SceneFile =
         toml::from_str(text).map_err(|e| fail(e.to_string().trim_end().to_string()))?;
-    raw.check().map_err(fail)
+    raw.check(size)
+        .map_err(|message| match (size.width, size.height) {
+            (None, None) => fail(message),
+            _ if message.starts_with("--") => Error::Usage(message),
+            _ => fail(message),
+        })
 }
 
-/// Refuse an image size that is zero or too large, naming where it came from.
-pub fn check_image_size(width: u32, height: u32, source: &str) -> Result<(), String> {
-    for (name, value) in [("width", width), ("height", height)] {
+/// Refuse an image size that is zero or too large, naming where each side came
+/// from (`image.width` or `--width`).
+pub fn check_image_size(width: (u32, &str), height: (u32, &str)) -> Result<(), String> {
+    for (value, source) in [width, height] {
         if value == 0 || value > MAX_SIDE {
             return Err(format!(
-                "{source}{name} = {value}: must be from 1 to {MAX_SIDE} pixels"
+                "{source} = {value}: must be from 1 to {MAX_SIDE} pixels"
             ));
         }
     }
-    let pixels = u64::from(width) * u64::from(height);
+    let pixels = u64::from(width.0) * u64::from(height.0);
     if pixels > MAX_PIXELS {
+        let gigabytes = (pixels * PEAK_BYTES_PER_PIXEL) as f64 / 1e9;
         return Err(format!(
-            "{source}{width} × {height} is {pixels} pixels; at most {MAX_PIXELS} are rendered \
-             (about {} MiB of buffers)",
-            pixels * std::mem::size_of::<crate::aov::PixelRecord>() as u64 / (1 << 20)
+            "{} = {} and {} = {} make {pixels} pixels; raystep renders at most {MAX_PIXELS} \
+             (7680 × 4320), since a render needs about {PEAK_BYTES_PER_PIXEL} bytes per pixel \
+             and this one would need {gigabytes:.1} GB",
+            width.1, width.0, height.1, height.0
         ));
     }
     Ok(())
@@ -108,7 +152,24 @@ pub fn check_max_depth(max_depth: u32, source: &str) -> Result<(), String> {
     }
 }
 
-type Triple = [f64; 3];
+/// Three numbers `[x, y, z]`: exactly three, so that a fourth is an error, not
+/// silently dropped.
+#[derive(Clone, Copy, Debug)]
+struct Triple([f64; 3]);
+
+impl<'de> Deserialize<'de> for Triple {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Triple, D::Error> {
+        let numbers = Vec::<f64>::deserialize(d)?;
+        <[f64; 3]>::try_from(numbers.as_slice())
+            .map(Triple)
+            .map_err(|_| {
+                serde::de::Error::custom(format!(
+                    "expected three numbers [x, y, z], found {}",
+                    numbers.len()
+                ))
+            })
+    }
+}
 
 // ANCHOR: schema
 #[derive(Deserialize)]
@@ -221,14 +282,21 @@ macro_rules! material_keys {
 }
 
 impl SceneFile {
-    fn check(self) -> Result<Scene, String> {
+    fn check(self, size: SizeOverride) -> Result<Scene, String> {
         let image = self.image.unwrap_or(ImageKeys {
             width: None,
             height: None,
         });
-        let width = image.width.unwrap_or(300);
-        let height = image.height.unwrap_or(200);
-        check_image_size(width, height, "image.")?;
+        let width = match size.width {
+            Some(w) => (w, "--width"),
+            None => (image.width.unwrap_or(300), "image.width"),
+        };
+        let height = match size.height {
+            Some(h) => (h, "--height"),
+            None => (image.height.unwrap_or(200), "image.height"),
+        };
+        check_image_size(width, height)?;
+        let (width, height) = (width.0, height.0);
 
         let camera = point(self.camera.position, "camera.position")?;
         if camera.z == 0.0 {
@@ -252,11 +320,7 @@ impl SceneFile {
         };
 
         let max_depth = self.render.and_then(|r| r.max_depth).unwrap_or(3);
-        if !(1..=MAX_DEPTH).contains(&max_depth) {
-            return Err(format!(
-                "render.max_depth = {max_depth}: must be from 1 to {MAX_DEPTH}"
-            ));
-        }
+        check_max_depth(max_depth, "render.max_depth")?;
 
         let mut objects = Vec::new();
         for (i, keys) in self.sphere.into_iter().enumerate() {
@@ -369,18 +433,20 @@ impl MaterialKeys {
 }
 
 fn number(value: f64, key: &str) -> Result<f64, String> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
+    if !value.is_finite() {
         Err(format!("{key}: {value} is not a finite number"))
+    } else if value.abs() > MAX_MAGNITUDE {
+        Err(format!("{key}: {value} is larger than {MAX_MAGNITUDE:e} in magnitude, the most raystep accepts"))
+    } else {
+        Ok(value)
     }
 }
 
 fn point(value: Triple, key: &str) -> Result<Vec3, String> {
-    for v in value {
+    for v in value.0 {
         number(v, key)?;
     }
-    Ok(Vec3::from(value))
+    Ok(Vec3::from(value.0))
 }
 
 fn colour(value: Option<Triple>, default: Vec3, key: &str) -> Result<Vec3, String> {
@@ -390,7 +456,8 @@ fn colour(value: Option<Triple>, default: Vec3, key: &str) -> Result<Vec3, Strin
     let c = point(value, key)?;
     if c.min_element() < 0.0 {
         return Err(format!(
-            "{key}: {value:?} has a negative component; colours are 0 or more"
+            "{key}: {:?} has a negative component; colours are 0 or more",
+            value.0
         ));
     }
     Ok(c)

@@ -66,13 +66,15 @@ impl<T: Real> Sphere<T> {
         let b = two * ray.direction.dot(oc);
         let c = oc.length_squared() - self.radius * self.radius;
         let delta = b * b - four * c;
-        if !(delta > T::of(0.0)) {
-            return None;
+        // Δ > 0: two crossings (a NaN, from an infinite input, is a miss too).
+        if delta > T::of(0.0) {
+            let root = delta.sqrt();
+            let t1 = (-b + root) / two;
+            let t2 = (-b - root) / two;
+            Some((t1.min(t2), t1.max(t2)))
+        } else {
+            None
         }
-        let root = delta.sqrt();
-        let t1 = (-b + root) / two;
-        let t2 = (-b - root) / two;
-        Some((t1.min(t2), t1.max(t2)))
     }
 }
 // ANCHOR_END: naive
@@ -96,16 +98,17 @@ impl<T: Real> Sphere<T> {
         let closest = f + ray.direction * h;
         let r2 = self.radius * self.radius;
         let quarter_delta = r2 - closest.length_squared();
-        if !(quarter_delta > T::of(0.0)) {
-            return None;
+        if quarter_delta > T::of(0.0) {
+            let q = h + h.signum() * quarter_delta.sqrt();
+            let c = f.length_squared() - r2;
+            let (t1, t2) = (c / q, q);
+            // |q| = |h| + √(Δ/4) > 0, so c/q never divides by zero; the guard keeps
+            // it so if that reasoning is ever broken. (A NaN passes it, and fails
+            // the "both roots positive" test of `intersect` instead.)
+            (q != T::of(0.0)).then(|| (t1.min(t2), t1.max(t2)))
+        } else {
+            None
         }
-        let q = h + h.signum() * quarter_delta.sqrt();
-        if q == T::of(0.0) {
-            return None;
-        }
-        let c = f.length_squared() - r2;
-        let (t1, t2) = (c / q, q);
-        Some((t1.min(t2), t1.max(t2)))
     }
 }
 // ANCHOR_END: stable

@@ -115,6 +115,11 @@ impl Stages {
     pub fn select(last: Stage, without: &[Stage]) -> Result<Stages, String> {
         let mut stages = Stages::up_to(last);
         for &stage in without {
+            if stage > last {
+                return Err(format!(
+                    "--without {stage} does nothing: --stage {last} leaves {stage} off already"
+                ));
+            }
             stages.set(stage, false);
         }
         for stage in Stage::ALL.into_iter().filter(|&s| stages.is_on(s)) {
@@ -207,6 +212,12 @@ mod tests {
         );
         let err = Stages::select(Stage::Rays, &[Stage::Rays]).unwrap_err();
         assert!(err.contains("nothing would be rendered"), "{err}");
+    }
+
+    #[test]
+    fn turning_off_a_stage_that_is_off_already_is_refused() {
+        let err = Stages::select(Stage::Shadow, &[Stage::Plane]).unwrap_err();
+        assert!(err.contains("--without plane does nothing"), "{err}");
     }
 
     #[test]

@@ -52,12 +52,12 @@ fn includes(text: &str) -> Vec<(String, Option<String>)> {
 }
 
 #[test]
-fn every_chapter_file_is_in_the_summary_and_there_are_eight_chapters() {
+fn every_chapter_file_is_in_the_summary_and_there_are_nine_chapters() {
     let listed: Vec<String> = chapters().into_iter().map(|(n, _)| n).collect();
     assert_eq!(
         listed.len(),
-        9,
-        "the introduction and eight chapters: {listed:?}"
+        10,
+        "the introduction and nine chapters: {listed:?}"
     );
     for entry in std::fs::read_dir(root().join("chapters")).unwrap() {
         let name = entry.unwrap().file_name().to_string_lossy().into_owned();
@@ -213,16 +213,30 @@ fn assert_quotes(prefix: &str, quoted: &str) {
 #[test]
 fn the_numbers_the_chapters_quote_are_measured_again() {
     // Chapter 4: acne without the step.
-    let d = diff(
-        "render --stage shadow",
-        "render --stage shadow --offset fixed:0",
-    );
+    let step = "render --stage shadow --offset fixed:1e-5";
+    let none = "render --stage shadow --offset fixed:0";
+    let d = diff(step, none);
     assert_quotes(
         "04",
         &format!(
             "{} pixels differ by more than one 8-bit step",
             d.over_one_step
         ),
+    );
+    let (with, without) = (
+        render_command(step, &root()).unwrap(),
+        render_command(none, &root()).unwrap(),
+    );
+    let shadowed = with.pixels.iter().filter(|p| p.shadow == 0.0).count();
+    let turned = with
+        .pixels
+        .iter()
+        .zip(&without.pixels)
+        .filter(|(a, b)| a.shadow == 0.0 && b.shadow == 1.0)
+        .count();
+    assert_quotes(
+        "04",
+        &format!("{turned} of the {shadowed} pixels in\nshadow with the step"),
     );
     // Chapter 5: Blinn-Phong with and without the shadow stage.
     let d = diff(
@@ -236,17 +250,38 @@ fn the_numbers_the_chapters_quote_are_measured_again() {
             d.over_one_step
         ),
     );
-    // Chapter 7: the fake plane against a true one.
-    let d = diff("render scenes/seed.toml", "render scenes/true-plane.toml");
+    // Chapter 6: two segments against six.
+    let m = "render scenes/mirrors.toml --stage reflection --max-depth";
+    let d = diff(&format!("{m} 2"), &format!("{m} 6"));
     assert_quotes(
-        "07",
+        "06",
         &format!(
             "{} pixels differ by more than one 8-bit step",
             d.over_one_step
         ),
     );
-    // Chapter 8: the viewer on a bounce; the whole `raystep diff` report is quoted.
-    let d = diff("render", "render --viewer ray-origin");
+    // Chapter 7: the fake plane against a true one, and where they differ.
+    let (fake, width) = beauty("render scenes/seed.toml");
+    let (real, _) = beauty("render scenes/true-plane.toml");
+    let d = compare(&fake, &real, width);
+    let differing_rows: Vec<usize> = fake
+        .iter()
+        .zip(&real)
+        .enumerate()
+        .filter(|(_, (a, b))| (0..3).any(|c| (a[c] - b[c]).abs() > 1.0 / 255.0))
+        .map(|(i, _)| i / width)
+        .collect();
+    let near_horizon = differing_rows
+        .iter()
+        .filter(|r| (97..=108).contains(*r))
+        .count();
+    assert_quotes(
+        "07",
+        &format!("{} pixels differ by more than one 8-bit step (2.26 % of the picture), and {near_horizon} of\nthem lie in rows 97 to 108", d.over_one_step),
+    );
+    // Chapter 8: the viewer on a bounce, with the tutorial's rules; the whole
+    // `raystep diff` report is quoted.
+    let d = diff("render --tutorial", "render --tutorial --viewer ray-origin");
     let report = format!(
         "  differ by more than 1/255: {} pixels ({:.2} %)\n  largest difference:        {:.4} (row {}, column {})\n  root mean square:          {:.6}\n  clipped (a channel at 1):  {} and {} pixels",
         d.over_one_step,
@@ -268,6 +303,36 @@ fn the_numbers_the_chapters_quote_are_measured_again() {
     );
     // The tutorial's own count for the same change (TUTORIAL.md): 2,660 pixels.
     assert_eq!(d.over_one_step, 2660);
+}
+
+#[test]
+fn every_accuracy_row_a_chapter_quotes_is_what_raystep_accuracy_prints_now() {
+    let rows: Vec<String> = raystep::accuracy::measure_all()
+        .iter()
+        .map(raystep::accuracy::table_row)
+        .collect();
+    let header = raystep::accuracy::table_header();
+    let mut quoted = 0;
+    for (name, text) in chapters() {
+        for line in text.lines() {
+            let first = line.split_whitespace().next().unwrap_or("");
+            if raystep::accuracy::CASES
+                .iter()
+                .any(|(case, _)| *case == first)
+                && line.contains("  f")
+            {
+                assert!(
+                    rows.iter().any(|r| r == line),
+                    "{name} quotes a row `raystep accuracy` no longer prints:\n{line}"
+                );
+                quoted += 1;
+            }
+            if line.starts_with("case ") {
+                assert_eq!(line, header, "{name}: the table header");
+            }
+        }
+    }
+    assert!(quoted >= 20, "{quoted} rows quoted");
 }
 
 #[test]
@@ -311,7 +376,7 @@ fn chapter_7_quotes_where_the_horizons_are() {
     );
     assert_quotes(
         "07",
-        "rows 101\nand 102 of the 300 × 200 picture, against row 99",
+        "the last row of sky is row 101 across most of the width and row\n102 near the edges, against row 99",
     );
 }
 

@@ -198,13 +198,15 @@ fn mistakes_end_in_one_clear_message_and_exit_code_2() {
         ("negative size in the file", Some(scene_with("[image]\nheight = -5\n")), vec![], vec!["height", "invalid value"]),
         ("zero width flag", Some(scene_with("")), vec!["--width", "0"], vec!["--width = 0", "1 to 16384"]),
         ("absurd height flag", Some(scene_with("")), vec!["--height", "20000"], vec!["--height = 20000", "1 to 16384"]),
-        ("too many pixels", Some(scene_with("")), vec!["--width", "16384", "--height", "16384"], vec!["pixels", "at most"]),
+        ("too many pixels", Some(scene_with("")), vec!["--width", "16384", "--height", "16384"], vec!["--width = 16384 and --height = 16384 make 268435456 pixels", "at most 33177600"]),
         ("max_depth 0", Some(scene_with("[render]\nmax_depth = 0\n")), vec![], vec!["render.max_depth = 0", "from 1 to 64"]),
         ("reflection above 1", Some(sphere("radius = 1\nreflection = 2")), vec![], vec!["reflection", "from 0 (matte) to 1"]),
         ("negative colour", Some(sphere("radius = 1\ndiffuse = [0.5, -1, 0]")), vec![], vec!["diffuse", "negative"]),
         ("plane with two shapes", Some(scene_with("[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\nsphere = { center = [0, -9, 0], radius = 8 }\n")), vec![], vec!["[[plane]] number 1", "not both"]),
         ("plane with a zero normal", Some(scene_with("[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 0, 0]\n")), vec![], vec!["normal", "non-zero"]),
-        ("not UTF-8", Some(String::from_utf8_lossy(&[0xff, 0xfe, 0x00]).into_owned()), vec![], vec!["bad.toml"]),
+        ("a fourth number in a vector", Some(scene_with("[[sphere]]\ncenter = [0, 0, -1, 5]\nradius = 1\n")), vec![], vec!["center", "expected three numbers [x, y, z], found 4"]),
+        ("a huge number", Some(sphere("radius = 1e300")), vec![], vec!["radius", "larger than 1e15"]),
+        ("a stage that is off already", Some(scene_with("")), vec!["--stage", "shadow", "--without", "plane"], vec!["--without plane does nothing"]),
         ("a stage without what it needs", Some(scene_with("")), vec!["--stage", "shadow", "--without", "intersection"], vec!["`shadow` cannot run without `intersection`"]),
         ("unknown stage", Some(scene_with("")), vec!["--stage", "shadows"], vec!["invalid value 'shadows'", "shadow"]),
         ("offset without a kind", Some(scene_with("")), vec!["--offset", "1e-5"], vec!["--offset", "expected auto or fixed:VALUE"]),
@@ -317,4 +319,43 @@ fn a_closed_stdout_is_not_a_crash() {
     let status = child.wait().unwrap();
     assert!(status.success(), "{status:?}: {stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn a_file_that_is_not_text_or_never_ends_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("binary.toml"), [0xff, 0xfe, 0x00, 0x12]).unwrap();
+    let out = raystep(dir.path(), &["check", "binary.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("binary.toml: is not a text file (not UTF-8)"),
+        "{}",
+        text(&out.stderr)
+    );
+    // A device has no length to check beforehand; reading stops past the limit.
+    let out = raystep(dir.path(), &["check", "/dev/zero"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("/dev/zero: is larger than 16777216 bytes"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+#[test]
+fn size_flags_override_a_size_the_file_gets_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("big.toml"),
+        scene_with("[image]\nwidth = 20000\n"),
+    )
+    .unwrap();
+    let out = raystep(
+        dir.path(),
+        &["render", "big.toml", "--width", "40", "--height", "30"],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = raystep(dir.path(), &["check", "big.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("image.width = 20000"));
 }

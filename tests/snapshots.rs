@@ -5,7 +5,7 @@
 
 mod common;
 
-use raystep::output::png_bytes;
+use raystep::output::{exr_bytes, png_bytes};
 use raystep::stages::{Stage, Stages};
 
 #[test]
@@ -18,6 +18,14 @@ fn every_stage_and_buffer_of_the_seed_scene() {
             insta::assert_binary_snapshot!(name.as_str(), png_bytes(&frame, buffer));
         }
     }
+}
+
+/// The raw floats too, not only their 8-bit pictures: the EXR of the last stage
+/// holds every buffer (a depth scaled by a constant would not change depth.png).
+#[test]
+fn the_float_buffers_of_the_seed_scene() {
+    let frame = common::render(&common::seed(100, 70), Stages::ALL);
+    insta::assert_binary_snapshot!("seed-06-plane-buffers.exr", exr_bytes(&frame).unwrap());
 }
 
 /// The small scenes, each at the stage it was made to show.

@@ -1,0 +1,125 @@
+//! What each method costs: `cargo bench --bench methods`.
+//!
+//! Renders of figure 1 (320 × 240, every stage) for every precision ×
+//! intersection method × offset, the fake floor against a true plane, and the
+//! ray-sphere intersection alone.
+
+use divan::Bencher;
+use raystep::ray::Ray;
+use raystep::real::{Precision, Real, Vector};
+use raystep::render::{render, Settings};
+use raystep::shade::shadow::Offset;
+use raystep::sphere::{Method, Sphere};
+use raystep::stages::Stages;
+use raystep::Vec3;
+
+fn main() {
+    divan::main();
+}
+
+fn seed() -> raystep::scene::Scene {
+    let mut scene = raystep::scene_file::seed();
+    (scene.width, scene.height) = (320, 240);
+    scene
+}
+
+const CONFIGS: [(&str, Precision, Method, Offset); 6] = [
+    (
+        "f64 naive fixed (tutorial)",
+        Precision::F64,
+        Method::Naive,
+        Offset::TUTORIAL,
+    ),
+    (
+        "f64 stable fixed",
+        Precision::F64,
+        Method::Stable,
+        Offset::TUTORIAL,
+    ),
+    (
+        "f64 stable auto (default)",
+        Precision::F64,
+        Method::Stable,
+        Offset::Auto,
+    ),
+    (
+        "f32 naive fixed",
+        Precision::F32,
+        Method::Naive,
+        Offset::TUTORIAL,
+    ),
+    (
+        "f32 stable fixed",
+        Precision::F32,
+        Method::Stable,
+        Offset::TUTORIAL,
+    ),
+    (
+        "f32 stable auto",
+        Precision::F32,
+        Method::Stable,
+        Offset::Auto,
+    ),
+];
+
+#[divan::bench(args = [0, 1, 2, 3, 4, 5], sample_count = 60)]
+fn figure_1(bencher: Bencher, config: usize) {
+    let (_, precision, method, offset) = CONFIGS[config];
+    let scene = seed();
+    let settings = Settings {
+        precision,
+        method,
+        offset,
+        ..Settings::from(Stages::ALL)
+    };
+    bencher.bench(|| render(&scene, &settings, &|_| {}));
+}
+
+#[divan::bench(args = ["fake", "true"], sample_count = 60)]
+fn floor(bencher: Bencher, kind: &str) {
+    let scene = match kind {
+        "fake" => seed(),
+        _ => {
+            let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/true-plane.toml");
+            let mut s = raystep::scene_file::load(path.as_ref()).unwrap();
+            (s.width, s.height) = (320, 240);
+            s
+        }
+    };
+    let settings = Settings::from(Stages::ALL);
+    bencher.bench(|| render(&scene, &settings, &|_| {}));
+}
+
+/// 4,096 rays from the camera towards the red sphere and around it.
+fn rays<T: Real>() -> Vec<Ray<T>> {
+    (0..4096)
+        .map(|i| {
+            let (x, y) = ((i % 64) as f64 / 32.0 - 1.0, (i / 64) as f64 / 32.0 - 1.0);
+            Ray::towards(
+                T::Vec3::of(Vec3::new(0.0, 0.0, 1.0)),
+                T::Vec3::of(Vec3::new(x, y, -1.0)),
+            )
+        })
+        .collect()
+}
+
+#[divan::bench(types = [f32, f64], args = ["naive", "stable"])]
+fn intersect<T: Real>(bencher: Bencher, method: &str) {
+    let method = if method == "naive" {
+        Method::Naive
+    } else {
+        Method::Stable
+    };
+    let sphere = Sphere::<T> {
+        center: T::Vec3::of(Vec3::new(-0.2, 0.0, -1.0)),
+        radius: T::of(0.7),
+    };
+    let rays = rays::<T>();
+    bencher
+        .counter(divan::counter::ItemsCount::new(rays.len()))
+        .bench(|| {
+            rays.iter()
+                .filter(|r| sphere.intersect(divan::black_box(r), method).is_some())
+                .count()
+        });
+}
