@@ -2,9 +2,11 @@
 //! intersection method and offset, and measured against a careful reference
 //! (`raystep accuracy`).
 //!
-//! The reference works in float64 with the stable method on the very rays the
-//! method under test traced (a float32 ray is converted exactly), so it judges the
-//! arithmetic of the intersection and the offset, not the rounding of the camera.
+//! The reference works in float64 with the stable method on the very rays and the
+//! very objects the method under test used (float32 numbers are converted to
+//! float64 exactly), so it judges the arithmetic of the intersection and the
+//! offset, not the rounding of the camera or of the scene's numbers: in float32,
+//! the fake floor's radius 8999.3 is 8999.2998, and that sphere is the one judged.
 
 use serde::Serialize;
 
@@ -86,7 +88,9 @@ pub struct Measure {
     pub false_misses: usize,
     /// The largest distance of a first hit point from its surface, in scene units.
     pub max_surface_error: f64,
-    /// The same, in unit roundoffs of the surface's magnitude (dimensionless).
+    /// The largest of each hit's distance from its surface divided by the unit
+    /// roundoff times its surface's magnitude (dimensionless; it need not come from
+    /// the same hit as `max_surface_error`).
     pub max_surface_error_ulps: f64,
     /// Fraction of first hits whose stepped-off origin is not outside the surface:
     /// the cause of acne, whichever way it shows.
@@ -122,14 +126,22 @@ pub fn measure(
 /// Every stress case × precision × method × offset (fixed:0, the tutorial's
 /// fixed:1e-5, auto).
 pub fn measure_all() -> Vec<Measure> {
+    CASES
+        .iter()
+        .flat_map(|(name, _)| measure_case(name))
+        .collect()
+}
+
+/// Every precision × method × offset on one stress case (none if it is unknown).
+pub fn measure_case(name: &str) -> Vec<Measure> {
+    let Some(scene) = case(name) else {
+        return Vec::new();
+    };
     let mut rows = Vec::new();
-    for (name, _) in CASES {
-        let scene = case(name).expect("listed");
-        for precision in [Precision::F32, Precision::F64] {
-            for method in [Method::Naive, Method::Stable] {
-                for offset in [Offset::Fixed(0.0), Offset::TUTORIAL, Offset::Auto] {
-                    rows.push(measure(name, &scene, precision, method, offset));
-                }
+    for precision in [Precision::F32, Precision::F64] {
+        for method in [Method::Naive, Method::Stable] {
+            for offset in [Offset::Fixed(0.0), Offset::TUTORIAL, Offset::Auto] {
+                rows.push(measure(name, &scene, precision, method, offset));
             }
         }
     }
@@ -138,8 +150,8 @@ pub fn measure_all() -> Vec<Measure> {
 
 fn measure_in<T: Real>(scene: &Scene, settings: &Settings) -> Measure {
     let tracer = Tracer::<T>::new(scene, settings);
-    let reference: Vec<Object> = scene.objects_in_play(Stages::ALL);
-    let light = scene.light.position;
+    let reference: Vec<Object> = tracer.objects.iter().map(Object::exact).collect();
+    let light = tracer.light.position.to_f64();
     let mut m = Measure {
         case: String::new(),
         precision: T::NAME.to_string(),
@@ -168,9 +180,15 @@ fn measure_in<T: Real>(scene: &Scene, settings: &Settings) -> Measure {
             let truth = reference_hit(&reference, &exact_ray);
 
             if let Some(truth) = truth {
-                match (traced.first.is_some(), truth.hit.is_some()) {
-                    (true, false) => m.false_hits += 1,
-                    (false, true) => m.false_misses += 1,
+                match (traced.first.map(|f| f.object), truth.hit) {
+                    (Some(_), None) => m.false_hits += 1,
+                    (None, Some(_)) => m.false_misses += 1,
+                    // The wrong object counts as both: a miss of the right one, a
+                    // hit of the wrong one.
+                    (Some(a), Some(b)) if a != b => {
+                        m.false_hits += 1;
+                        m.false_misses += 1;
+                    }
                     _ => {}
                 }
                 m.judged += 1;
@@ -189,7 +207,12 @@ fn measure_in<T: Real>(scene: &Scene, settings: &Settings) -> Measure {
             m.max_surface_error_ulps = m.max_surface_error_ulps.max(ulps);
             // Is the stepped-off origin outside the surface?
             let shifted = step_off(point, T::Vec3::of(first.normal), object, settings.offset);
-            if surface_distance(exact_object, shifted.to_f64()) <= 0.0 {
+            // Outside means on the side the ray came from (for a plane: the face hit).
+            let side = match exact_object.shape {
+                Shape::Plane(pl) if pl.normal.dot(first.normal) < 0.0 => -1.0,
+                _ => 1.0,
+            };
+            if side * surface_distance(exact_object, shifted.to_f64()) <= 0.0 {
                 stuck += 1;
             }
             // Is the shadow verdict the reference's?
@@ -218,12 +241,15 @@ struct Truth {
 fn reference_hit(objects: &[Object], ray: &Ray) -> Option<Truth> {
     let mut nearest: Option<(f64, usize)> = None;
     for (i, o) in objects.iter().enumerate() {
-        if let Shape::Sphere(s) = o.shape {
-            if near_silhouette(&s, ray) {
-                return None;
-            }
-        }
-        if let Some(t) = o.intersect(ray, Method::Stable) {
+        let t = match o.shape {
+            Shape::Sphere(s) => match exact_sphere(&s, ray) {
+                Crossing::Ambiguous => return None,
+                Crossing::Miss => None,
+                Crossing::Hit(t) => Some(t),
+            },
+            Shape::Plane(_) => o.intersect(ray, Method::Stable),
+        };
+        if let Some(t) = t {
             if nearest.is_none_or(|(n, _)| t < n) {
                 nearest = Some((t, i));
             }
@@ -234,10 +260,89 @@ fn reference_hit(objects: &[Object], ray: &Ray) -> Option<Truth> {
     })
 }
 
-fn near_silhouette(s: &Sphere, ray: &Ray) -> bool {
-    let f = ray.origin - s.center;
-    let closest = f - ray.direction * ray.direction.dot(f);
-    (closest.length() - s.radius).abs() <= SILHOUETTE_BAND * s.radius
+/// What the exact answer says of a ray and a sphere.
+enum Crossing {
+    /// Within [`SILHOUETTE_BAND`] of the silhouette: not judged.
+    Ambiguous,
+    /// Not hit by the tutorial's rule (no two crossings, or not both in front).
+    Miss,
+    /// Hit, at about this distance.
+    Hit(f64),
+}
+
+/// The tutorial's hit rule decided by signs computed in double-double arithmetic
+/// (about 106 bits), with the ray's direction as it is (not assumed of length 1):
+/// with f = O − C and a = ‖d‖², two crossings iff Δ/4 = ⟨f, d⟩² − a·(‖f‖² − r²) > 0,
+/// both in front iff ‖f‖ > r and ⟨f, d⟩ < 0.
+fn exact_sphere(s: &Sphere, ray: &Ray) -> Crossing {
+    use dd::Dd;
+    let f: [Dd; 3] = [0, 1, 2].map(|i| Dd::diff(ray.origin[i], s.center[i]));
+    let d = ray.direction.to_array();
+    let fd = (0..3).fold(Dd::ZERO, |acc, i| acc.add(f[i].mul_f64(d[i])));
+    let ff = (0..3).fold(Dd::ZERO, |acc, i| acc.add(f[i].mul(f[i])));
+    let a = (0..3).fold(Dd::ZERO, |acc, i| acc.add(Dd::product(d[i], d[i])));
+    let c = ff.sub(Dd::product(s.radius, s.radius));
+    let quarter_delta = fd.mul(fd).sub(a.mul(c));
+    if quarter_delta.value().abs() <= 2.0 * SILHOUETTE_BAND * s.radius * s.radius * a.value() {
+        return Crossing::Ambiguous;
+    }
+    if quarter_delta.value() <= 0.0 || c.value() <= 0.0 || fd.value() >= 0.0 {
+        return Crossing::Miss;
+    }
+    // The near root, (−⟨f, d⟩ − √(Δ/4)) / a, written without cancellation.
+    let q = -fd.value() + quarter_delta.value().sqrt();
+    Crossing::Hit(c.value() / q)
+}
+
+/// Double-double numbers: a value as the unevaluated sum of two float64s, about
+/// 106 bits. Enough to decide the sign of the short expressions above.
+mod dd {
+    /// hi + lo, with |lo| at most half an ulp of hi.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Dd(f64, f64);
+
+    fn two_sum(a: f64, b: f64) -> Dd {
+        let s = a + b;
+        let v = s - a;
+        Dd(s, (a - (s - v)) + (b - v))
+    }
+
+    impl Dd {
+        pub const ZERO: Dd = Dd(0.0, 0.0);
+
+        /// a − b, exactly.
+        pub fn diff(a: f64, b: f64) -> Dd {
+            two_sum(a, -b)
+        }
+
+        /// a·b, exactly.
+        pub fn product(a: f64, b: f64) -> Dd {
+            let p = a * b;
+            Dd(p, a.mul_add(b, -p))
+        }
+
+        pub fn add(self, o: Dd) -> Dd {
+            let s = two_sum(self.0, o.0);
+            two_sum(s.0, s.1 + self.1 + o.1)
+        }
+
+        pub fn sub(self, o: Dd) -> Dd {
+            self.add(Dd(-o.0, -o.1))
+        }
+
+        pub fn mul(self, o: Dd) -> Dd {
+            let p = Dd::product(self.0, o.0);
+            two_sum(p.0, p.1 + self.0 * o.1 + self.1 * o.0)
+        }
+
+        pub fn mul_f64(self, x: f64) -> Dd {
+            self.mul(Dd(x, 0.0))
+        }
+
+        pub fn value(self) -> f64 {
+            self.0 + self.1
+        }
+    }
 }
 
 /// Signed distance from `p` to the surface: positive outside (a sphere) or on the
@@ -287,15 +392,16 @@ fn reference_lit(
         if i == index {
             continue;
         }
-        if let Shape::Sphere(s) = other.shape {
-            if near_silhouette(&s, &ray) {
-                return None;
-            }
-        }
-        if let Some(t) = other.intersect(&ray, Method::Stable) {
-            if t < distance {
-                lit = false;
-            }
+        let t = match other.shape {
+            Shape::Sphere(s) => match exact_sphere(&s, &ray) {
+                Crossing::Ambiguous => return None,
+                Crossing::Miss => None,
+                Crossing::Hit(t) => Some(t),
+            },
+            Shape::Plane(_) => other.intersect(&ray, Method::Stable),
+        };
+        if t.is_some_and(|t| t < distance) {
+            lit = false;
         }
     }
     Some(lit)

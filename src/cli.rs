@@ -382,10 +382,10 @@ fn accuracy(args: &AccuracyArgs) -> Result<(), Error> {
             )));
         }
     }
-    let rows: Vec<_> = measure_all()
-        .into_iter()
-        .filter(|m| args.case.as_ref().is_none_or(|c| &m.case == c))
-        .collect();
+    let rows = match &args.case {
+        Some(case) => crate::accuracy::measure_case(case),
+        None => measure_all(),
+    };
     if args.json {
         say!(
             "{}",

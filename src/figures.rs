@@ -56,7 +56,6 @@ pub const FIGURES: &[Figure] = &[
     fig("ch09/tiny-auto", "render scenes/stress/tiny-sphere.toml", &[Beauty, Shadow]),
     fig("ch09/x0001-tutorial", "render scenes/stress/seed-x0.001.toml --tutorial", &[Shadow]),
     fig("ch09/x0001-auto", "render scenes/stress/seed-x0.001.toml", &[Shadow]),
-    fig("ch09/contact", "render scenes/stress/contact.toml", &[Beauty]),
 ];
 
 const fn fig(name: &'static str, args: &'static str, buffers: &'static [Buffer]) -> Figure {

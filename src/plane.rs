@@ -17,7 +17,8 @@ pub struct Plane<T: Real = f64> {
 // ANCHOR: intersect
 impl<T: Real> Plane<T> {
     /// Distance along `ray` to the plane, if the ray crosses it in front of the
-    /// origin: `t = ⟨P − O, n⟩ / ⟨d, n⟩`. A ray parallel to the plane misses.
+    /// origin: `t = ⟨P − O, n⟩ / ⟨d, n⟩`. A ray parallel to the plane misses, and
+    /// so does one so nearly parallel that `t` overflows to infinity.
     pub fn intersect(&self, ray: &Ray<T>) -> Option<T> {
         let zero = T::of(0.0);
         let facing = ray.direction.dot(self.normal);
@@ -25,7 +26,7 @@ impl<T: Real> Plane<T> {
             return None;
         }
         let t = (self.point - ray.origin).dot(self.normal) / facing;
-        (t > zero).then_some(t)
+        (t > zero && t.is_finite()).then_some(t)
     }
 
     /// The unit normal on the side the ray came from: a plane has two faces and

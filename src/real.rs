@@ -46,6 +46,8 @@ pub trait Real:
     fn min(self, other: Self) -> Self;
     /// 1 with the sign of `self` (+1 for +0).
     fn signum(self) -> Self;
+    /// Neither infinite nor NaN.
+    fn is_finite(self) -> bool;
 }
 
 /// A 3-vector of [`Real`]s: a point, a direction or a colour.
@@ -78,7 +80,8 @@ pub trait Vector<T>:
     fn distance(self, other: Self) -> T;
     /// The largest absolute value of a component.
     fn max_abs(self) -> T;
-    /// Each component clamped to [0, 1].
+    /// Each component clamped to [0, 1]; a NaN stays NaN, so that a bug shows
+    /// instead of turning black.
     fn clamp01(self) -> Self;
     /// The vector nearest to a float64 one.
     fn of(v: DVec3) -> Self;
@@ -113,6 +116,9 @@ macro_rules! real {
             fn min(self, other: $t) -> $t {
                 <$t>::min(self, other)
             }
+            fn is_finite(self) -> bool {
+                <$t>::is_finite(self)
+            }
             fn signum(self) -> $t {
                 if self >= 0.0 {
                     1.0
@@ -146,7 +152,8 @@ macro_rules! real {
                 self.abs().max_element()
             }
             fn clamp01(self) -> $v {
-                self.clamp(<$v>::ZERO, <$v>::ONE)
+                let clip = |c: $t| if c.is_nan() { c } else { c.clamp(0.0, 1.0) };
+                <$v>::new(clip(self.x), clip(self.y), clip(self.z))
             }
             fn of(v: DVec3) -> $v {
                 <$v>::new(v.x as $t, v.y as $t, v.z as $t)

@@ -196,6 +196,35 @@ impl<T: Real> Object<T> {
     }
 }
 
+impl<T: Real> Object<T> {
+    /// The same object in float64, exactly: every number of precision `T` is a
+    /// float64 number too.
+    pub fn exact(&self) -> Object {
+        let shape = match self.shape {
+            Shape::Sphere(s) => Shape::Sphere(Sphere {
+                center: s.center.to_f64(),
+                radius: s.radius.to_f64(),
+            }),
+            Shape::Plane(p) => Shape::Plane(Plane {
+                point: p.point.to_f64(),
+                normal: p.normal.to_f64(),
+            }),
+        };
+        let m = &self.material;
+        Object {
+            shape,
+            material: Material {
+                ambient: m.ambient.to_f64(),
+                diffuse: m.diffuse.to_f64(),
+                specular: m.specular.to_f64(),
+                shininess: m.shininess.to_f64(),
+                reflection: m.reflection.to_f64(),
+            },
+            role: self.role,
+        }
+    }
+}
+
 impl Object {
     /// The same object in precision `T`.
     pub fn cast<T: Real>(&self) -> Object<T> {

@@ -392,9 +392,14 @@ impl PlaneKeys {
                         "{at}, normal: must be a non-zero vector of moderate size"
                     ));
                 }
+                // Any point of the plane names it; keep the one nearest the origin,
+                // so that the numbers the plane is computed from are no larger than
+                // the plane's distance from the origin.
+                let normal = normal.normalize();
+                let anchor = point(p, &format!("{at}, point"))?;
                 Ok(Shape::Plane(Plane {
-                    point: point(p, &format!("{at}, point"))?,
-                    normal: normal.normalize(),
+                    point: normal * anchor.dot(normal),
+                    normal,
                 }))
             }
             _ => Err(format!(

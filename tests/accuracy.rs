@@ -5,12 +5,13 @@
 mod common;
 
 use proptest::prelude::*;
-use raystep::accuracy::{case, measure, surface_distance, Measure, CASES};
+use proptest::test_runner::TestCaseError;
+use raystep::accuracy::{case, measure, Measure, CASES};
 use raystep::ray::Ray;
 use raystep::real::{Precision, Real, Vector};
 use raystep::render::{render, Settings};
 use raystep::scene::{Material, Object, Role, Shape};
-use raystep::shade::shadow::{step_off, Offset, AUTO_FACTOR};
+use raystep::shade::shadow::{step_off, Offset};
 use raystep::sphere::{Method, Sphere};
 use raystep::stages::Stages;
 use raystep::Vec3;
@@ -25,10 +26,14 @@ fn run(name: &str, precision: Precision, method: Method, offset: Offset) -> Meas
 const TUTORIAL: Offset = Offset::TUTORIAL;
 const AUTO: Offset = Offset::Auto;
 
+/// The largest distance of a hit point from its surface that the defaults may
+/// leave, in unit roundoffs of the surface's size (measured: at most 6.2).
+const SURFACE_BOUND: f64 = 8.0;
+
 /// The defaults get every case right: hit or miss as the reference says (outside
-/// 1e-9 of a radius from a silhouette), hit points within 16 unit roundoffs of the
-/// surface's size, every stepped-off origin outside its surface, every shadow
-/// verdict the reference's (away from the terminator).
+/// 1e-9 of a radius from a silhouette), hit points within [`SURFACE_BOUND`] unit
+/// roundoffs of the surface's size, every stepped-off origin outside its surface,
+/// every shadow verdict the reference's (away from the terminator).
 #[test]
 fn the_defaults_pass_every_stress_case() {
     assert_eq!(Settings::from(Stages::ALL).precision, F64);
@@ -43,7 +48,7 @@ fn the_defaults_pass_every_stress_case() {
             m.pixels
         );
         assert_eq!((m.false_hits, m.false_misses), (0, 0), "{name}");
-        assert!(m.max_surface_error_ulps <= AUTO_FACTOR, "{name}: {m:?}");
+        assert!(m.max_surface_error_ulps <= SURFACE_BOUND, "{name}: {m:?}");
         assert_eq!(m.stuck, 0.0, "{name}");
         assert_eq!(m.wrong_shadow, 0.0, "{name}");
     }
@@ -90,22 +95,37 @@ fn grazing_rays_hit_where_they_miss_with_the_textbook_quadratic_in_float32() {
 
 #[test]
 fn the_fixed_step_is_too_small_for_the_fake_floor_in_float32() {
-    // Hit points on the fake floor land far more than 1e-5 off its surface in
-    // float32, so the tutorial's step leaves origins inside it.
+    // Hit points on the fake floor land tens of times the tutorial's 1e-5 step off
+    // its surface in float32 (a bias from rounding c = ‖f‖² − r², shared by every
+    // ray from the camera); where the bias points inwards, origins stay inside.
     for name in ["horizon", "seed-x1"] {
-        let f32_tutorial = run(name, F32, Stable, TUTORIAL);
+        let tutorial = run(name, F32, Stable, TUTORIAL);
         assert!(
-            f32_tutorial.max_surface_error > 1e-4,
-            "{name}: {f32_tutorial:?}"
+            tutorial.max_surface_error > 20.0 * 1e-5,
+            "{name}: {tutorial:?}"
         );
-        assert!(f32_tutorial.stuck > 0.001, "{name}: {f32_tutorial:?}");
-        assert_eq!(run(name, F32, Stable, AUTO).stuck, 0.0, "{name}");
     }
-    // A true plane in the same view is computed from small numbers: 5,000 times
+    assert!(run("horizon", F32, Stable, TUTORIAL).stuck > 0.001);
+    assert_eq!(run("horizon", F32, Stable, AUTO).stuck, 0.0);
+    // A true plane in the same view is computed from small numbers: a thousand times
     // closer in float32.
     let fake = run("horizon", F32, Stable, AUTO).max_surface_error;
     let real = run("horizon-true", F32, Stable, AUTO).max_surface_error;
     assert!(real * 1000.0 < fake, "true {real}, fake {fake}");
+}
+
+#[test]
+fn a_true_plane_gets_classic_acne_without_a_step() {
+    // A plane has no "both roots positive" rule to hide behind: a shadow ray from a
+    // point just behind it meets it, and the lit side is speckled with shadow.
+    for precision in [F32, F64] {
+        let none = run("horizon-true", precision, Stable, Offset::Fixed(0.0));
+        assert!(none.wrong_shadow > 0.01, "{none:?}");
+        assert_eq!(
+            run("horizon-true", precision, Stable, AUTO).wrong_shadow,
+            0.0
+        );
+    }
 }
 
 #[test]
@@ -230,14 +250,15 @@ fn material() -> Material {
     }
 }
 
-/// A sphere at scale `s`, a ray from outside it aimed near its centre, in `T`.
-/// Returns the stepped-off origin after a hit, checked outside, or None on a miss.
-fn recast_check<T: Real>(
+/// A sphere, and a ray from outside it aimed near its centre, in `T`. After a hit:
+/// is the stepped-off origin strictly outside (checked exactly), and does a ray from
+/// it into the surface meet it, as a shadow ray into a dark side must?
+fn sphere_recast<T: Real>(
     center: Vec3,
     radius: f64,
     origin: Vec3,
     aim: Vec3,
-) -> Option<(bool, bool, bool)> {
+) -> Option<(bool, bool)> {
     let sphere = Object::<f64> {
         shape: Shape::Sphere(Sphere { center, radius }),
         material: material(),
@@ -252,18 +273,7 @@ fn recast_check<T: Real>(
     let point = ray.at(t);
     let normal = s.normal_at(point);
     let shifted = step_off(point, normal, &object, AUTO);
-    let exact_center = s.center.to_f64();
-    let outside = outside_exactly(shifted.to_f64(), exact_center, s.radius.to_f64());
-    // Away from the surface: never the same sphere again. Into it: always.
-    let away = s
-        .intersect(
-            &Ray {
-                origin: shifted,
-                direction: normal,
-            },
-            Stable,
-        )
-        .is_none();
+    let outside = outside_exactly(shifted.to_f64(), s.center.to_f64(), s.radius.to_f64());
     let into = s
         .intersect(
             &Ray {
@@ -273,7 +283,51 @@ fn recast_check<T: Real>(
             Stable,
         )
         .is_some();
-    Some((outside, away, into))
+    Some((outside, into))
+}
+
+/// A plane, and a ray that hits it, in `T`. After the hit: does a ray from the
+/// stepped-off origin leaving the face (any direction with d·n > 0) miss the plane,
+/// and one going through it (d·n < 0) meet it? (A plane, unlike a sphere under the
+/// tutorial's rule, can be met again by a ray that starts just behind it.)
+fn plane_recast<T: Real>(
+    point: Vec3,
+    normal: Vec3,
+    origin: Vec3,
+    aim: Vec3,
+    out: Vec3,
+) -> Option<(bool, bool)> {
+    let plane = Object::<f64> {
+        shape: Shape::Plane(raystep::plane::Plane { point, normal }),
+        material: material(),
+        role: Role::Floor,
+    };
+    let object = plane.cast::<T>();
+    let Shape::Plane(pl) = object.shape else {
+        unreachable!()
+    };
+    let ray: Ray<T> = Ray::towards(T::Vec3::of(origin), T::Vec3::of(aim));
+    let t = pl.intersect(&ray)?;
+    let hit = ray.at(t);
+    let face = pl.normal_towards(&ray);
+    let shifted = step_off(hit, face, &object, AUTO);
+    // A direction leaving the face, and its mirror through it.
+    let n = face.to_f64();
+    let leave = (out - n * out.dot(n) + n * (0.05 + out.dot(n).abs())).normalize();
+    let through = leave - n * (2.0 * leave.dot(n));
+    let misses = pl
+        .intersect(&Ray {
+            origin: shifted,
+            direction: T::Vec3::of(leave),
+        })
+        .is_none();
+    let meets = pl
+        .intersect(&Ray {
+            origin: shifted,
+            direction: T::Vec3::of(through),
+        })
+        .is_some();
+    Some((misses, meets))
 }
 
 fn scale() -> impl Strategy<Value = f64> {
@@ -290,24 +344,47 @@ proptest! {
     ))]
 
     #[test]
-    fn a_recast_ray_never_meets_its_own_surface_at_any_scale(
+    fn a_stepped_off_origin_is_outside_its_sphere_at_any_scale(
         s in scale(), offset_far in 0.0f64..4.0, c in unit(), from in unit(), jitter in unit(),
         size in 0.001f64..1.0,
     ) {
-        // A sphere of radius s·size somewhere within s·1e4·offset_far of the origin.
+        // A sphere of radius s·size up to s·1e4 from the origin, hit from outside.
         let center = c * s * 10f64.powf(offset_far);
         let radius = s * size;
         let dir = if from.length() < 1e-3 { Vec3::X } else { from.normalize() };
         let origin = center + dir * radius * (1.5 + 100.0 * jitter.x.abs());
-        let aim = center + jitter * radius * 0.9;
-        for (precision, result) in [
-            ("f64", recast_check::<f64>(center, radius, origin, aim)),
-            ("f32", recast_check::<f32>(center, radius, origin, aim)),
-        ] {
-            if let Some((outside, away, into)) = result {
+        let aim = center + jitter * radius * 0.5; // |jitter| ≤ √3, so inside
+        // In float64 the ray aimed inside always hits; in float32 the aim point
+        // itself may round outside a small far sphere, so a miss is allowed there.
+        let f64_result = sphere_recast::<f64>(center, radius, origin, aim);
+        prop_assert!(f64_result.is_some(), "f64: a ray aimed inside the sphere misses it");
+        for (precision, result) in [("f64", f64_result), ("f32", sphere_recast::<f32>(center, radius, origin, aim))] {
+            if let Some((outside, into)) = result {
                 prop_assert!(outside, "{precision}: stepped-off origin not outside");
-                prop_assert!(away, "{precision}: a ray leaving the surface hits it again");
                 prop_assert!(into, "{precision}: a ray into the surface misses it");
+            }
+        }
+    }
+
+    #[test]
+    fn a_ray_leaving_a_plane_never_meets_it_again_at_any_scale(
+        s in scale(), far in 0.0f64..4.0, p in unit(), n in unit(), from in unit(), aim in unit(), out in unit(),
+    ) {
+        // A plane through a point up to s·1e4 from the origin, hit from a point on
+        // one side, aimed at a point near its anchor.
+        prop_assume!(n.length() > 0.1 && out.length() > 0.1);
+        let normal = n.normalize();
+        let point = p * s * 10f64.powf(far);
+        let side = if from.dot(normal) >= 0.0 { 1.0 } else { -1.0 };
+        let origin = point + normal * side * s * (0.1 + from.length()) + (from - normal * from.dot(normal)) * s;
+        let target = point + (aim - normal * aim.dot(normal)) * s;
+        for (precision, result) in [
+            ("f64", plane_recast::<f64>(point, normal, origin, target, out)),
+            ("f32", plane_recast::<f32>(point, normal, origin, target, out)),
+        ] {
+            if let Some((misses, meets)) = result {
+                prop_assert!(misses, "{precision}: a ray leaving the plane meets it again");
+                prop_assert!(meets, "{precision}: a ray through the plane misses it");
             }
         }
     }
@@ -315,30 +392,106 @@ proptest! {
     #[test]
     fn no_nan_or_infinity_reaches_a_pixel(
         s in scale(), spheres in prop::collection::vec((unit(), 0.01f64..1.0), 1..4),
-        camera in unit(), light in unit(), inside in any::<bool>(), f32_precision in any::<bool>(),
+        camera in unit(), light in unit(), place in 0usize..4, light_inside in any::<bool>(),
+        f32_precision in any::<bool>(), naive in any::<bool>(), offset in 0usize..3,
     ) {
-        // Tangent rays, a camera at a centre or inside a sphere, a light inside one.
+        // Sphere k sits at (c·s) shifted by −s in z, with radius r·s.
+        let centers: Vec<Vec3> = spheres.iter().map(|(c, _)| Vec3::new(c.x * s, c.y * s, c.z * s - s)).collect();
+        let (c0, r0) = (centers[0], spheres[0].1 * s);
+        // The camera: anywhere, at the centre of sphere 0, or inside it.
+        let cam = match place {
+            0 | 1 => camera * s * 3.0,
+            2 => c0,
+            _ => c0 + camera.normalize_or_zero() * r0 * 0.5,
+        };
+        let cam = if cam.z == 0.0 { Vec3::new(cam.x, cam.y, s) } else { cam };
+        let light = if light_inside { c0 + light * r0 * 0.5 } else { light * s * 3.0 };
         let mut toml = String::new();
-        let cam = if inside { spheres[0].0 * s } else { camera * s * 3.0 };
-        let cam_z = if cam.z == 0.0 { s } else { cam.z };
-        toml += &format!("[image]\nwidth = 8\nheight = 6\n[camera]\nposition = [{}, {}, {}]\n", cam.x, cam.y, cam_z);
-        toml += &format!("[light]\nposition = [{}, {}, {}]\n", light.x * s, light.y * s, light.z * s);
-        for (c, r) in &spheres {
-            toml += &format!("[[sphere]]\ncenter = [{}, {}, {}]\nradius = {}\n", c.x * s, c.y * s, c.z * s - s, r * s);
+        toml += &format!("[image]\nwidth = 8\nheight = 6\n[camera]\nposition = [{}, {}, {}]\n", cam.x, cam.y, cam.z);
+        toml += &format!("[light]\nposition = [{}, {}, {}]\n", light.x, light.y, light.z);
+        for (c, (_, r)) in centers.iter().zip(&spheres) {
+            toml += &format!("[[sphere]]\ncenter = [{}, {}, {}]\nradius = {}\n", c.x, c.y, c.z, r * s);
         }
         toml += &format!("[[plane]]\npoint = [0, {}, 0]\nnormal = [0, 1, 0]\n", -s);
         let scene = raystep::scene_file::parse(&toml, "generated").unwrap();
         let settings = Settings {
             precision: if f32_precision { F32 } else { F64 },
+            method: if naive { Naive } else { Stable },
+            offset: [AUTO, TUTORIAL, Offset::Fixed(0.0)][offset],
             ..Settings::from(Stages::ALL)
         };
         let frame = render(&scene, &settings, &|_| {});
         for p in &frame.pixels {
-            prop_assert!(p.colour.iter().all(|c| c.is_finite() && (0.0..=1.0).contains(c)), "{:?}", p);
-            prop_assert!(!p.depth.is_nan() && p.depth > 0.0, "{:?}", p);
-            prop_assert!(p.normal.iter().all(|c| c.is_finite()), "{:?}", p);
-            prop_assert!(p.direction.iter().all(|c| c.is_finite()), "{:?}", p);
+            check_pixel(p)?;
         }
-        let _ = surface_distance;
+    }
+}
+
+/// A pixel has no NaN or infinity anywhere, and its buffers agree on hit or miss.
+fn check_pixel(p: &raystep::aov::PixelRecord) -> Result<(), TestCaseError> {
+    prop_assert!(
+        p.colour
+            .iter()
+            .all(|c| c.is_finite() && (0.0..=1.0).contains(c)),
+        "{:?}",
+        p
+    );
+    prop_assert!(p.direction.iter().all(|c| c.is_finite()), "{:?}", p);
+    prop_assert!(p.normal.iter().all(|c| c.is_finite()), "{:?}", p);
+    if p.shadow == -1.0 {
+        prop_assert!(
+            p.depth == f32::INFINITY && p.normal == [0.0; 3],
+            "a miss: {:?}",
+            p
+        );
+    } else {
+        // (A distance below float32's smallest number is stored as 0.)
+        prop_assert!(
+            p.depth.is_finite() && p.depth >= 0.0,
+            "a hit needs a finite depth: {:?}",
+            p
+        );
+    }
+    Ok(())
+}
+
+#[test]
+fn tangent_rays_and_a_light_inside_a_sphere_give_finite_pixels() {
+    // A pixel whose ray touches the sphere exactly (Δ = 0): the 3 × 3 image's middle
+    // column looks at x = 0, and the sphere's left edge is at x = 0 on that plane.
+    let toml = "[image]\nwidth = 3\nheight = 3\n[camera]\nposition = [0, 0, 1]\n\
+                [light]\nposition = [1, 0, -2]\n[[sphere]]\ncenter = [1, 0, -2]\nradius = 1\n\
+                [[plane]]\npoint = [0, -1, 0]\nnormal = [0, 1, 0]\n";
+    let scene = raystep::scene_file::parse(toml, "tangent").unwrap();
+    for precision in [F32, F64] {
+        for method in [Naive, Stable] {
+            let settings = Settings {
+                precision,
+                method,
+                ..Settings::from(Stages::ALL)
+            };
+            let frame = render(&scene, &settings, &|_| {});
+            for p in &frame.pixels {
+                check_pixel(p).unwrap();
+            }
+        }
+    }
+}
+
+#[test]
+fn a_too_small_height_above_a_plane_is_not_a_nan() {
+    // A camera 1e-310 above a true plane: t overflows to infinity for nearly parallel
+    // rays; the plane must count as missed, not give an infinite hit point.
+    let toml = "[image]\nwidth = 8\nheight = 6\n[camera]\nposition = [0, 1e-310, 1]\n\
+                [light]\nposition = [0, 5, 0]\n[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\n";
+    let scene = raystep::scene_file::parse(toml, "low").unwrap();
+    for precision in [F32, F64] {
+        let settings = Settings {
+            precision,
+            ..Settings::from(Stages::ALL)
+        };
+        for p in &render(&scene, &settings, &|_| {}).pixels {
+            check_pixel(p).unwrap();
+        }
     }
 }

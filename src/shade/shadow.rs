@@ -9,13 +9,17 @@ use crate::sphere::Method;
 /// ray from it.
 pub const TUTORIAL_STEP: f64 = 1e-5;
 
-/// The `auto` offset steps out by this many unit roundoffs of the numbers the
-/// surface is computed from. The rounding error of the projected point and of the
-/// next ray's first root is a few of them. Measured with the property test
-/// `a_recast_ray_never_meets_its_own_surface_at_any_scale` (`tests/accuracy.rs`,
-/// 20,000 random spheres and rays at scales 1e-3 to 1e4): a factor of 1 fails in
-/// float32, 2 and above pass; 16 leaves a margin of 8.
-pub const AUTO_FACTOR: f64 = 16.0;
+/// The `auto` offset steps out by this many unit roundoffs of the size of the
+/// numbers the surface is computed from. It has to cover the error of the point put
+/// back on the surface and the error of the next ray's first root, a few units
+/// each. Measured with the property tests `a_stepped_off_origin_is_outside_its_sphere_at_any_scale`
+/// and `a_ray_leaving_a_plane_never_meets_it_again_at_any_scale` (`tests/accuracy.rs`,
+/// `RAYSTEP_PROPTEST_CASES=20000`, scales 1e-3 to 1e4): a factor of 1 fails in
+/// float32, 2 fails in float64, 4 passes; 8 leaves a margin of 2. A larger factor
+/// costs accuracy the other way: shadow rays start too far out and pass over their
+/// own sphere at the terminator (in float32, a step about four times this one gave
+/// 6.55 % wrong shadows on `scenes/stress/far-sphere.toml`, against 3.42 %).
+pub const AUTO_FACTOR: f64 = 8.0;
 
 /// How far a hit point is moved along the normal before a shadow or reflected ray
 /// leaves it (`--offset`).
@@ -78,7 +82,7 @@ pub fn step_off<T: Real>(
         Offset::Fixed(step) => point + normal * T::of(step),
         Offset::Auto => {
             let on_surface = surface.project(point);
-            let scale = surface.magnitude() + on_surface.max_abs();
+            let scale = surface.magnitude().max(on_surface.max_abs());
             let bound = T::of(AUTO_FACTOR) * T::UNIT_ROUNDOFF * scale;
             on_surface + normal * bound
         }
