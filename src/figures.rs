@@ -56,6 +56,8 @@ pub const FIGURES: &[Figure] = &[
     fig("ch09/tiny-auto", "render scenes/stress/tiny-sphere.toml", &[Beauty, Shadow]),
     fig("ch09/x0001-tutorial", "render scenes/stress/seed-x0.001.toml --tutorial", &[Shadow]),
     fig("ch09/x0001-auto", "render scenes/stress/seed-x0.001.toml", &[Shadow]),
+    fig("ch09/plane-no-step", "render scenes/stress/horizon-true.toml --offset fixed:0", &[Beauty, Shadow]),
+    fig("ch09/plane-auto", "render scenes/stress/horizon-true.toml", &[Beauty, Shadow]),
 ];
 
 const fn fig(name: &'static str, args: &'static str, buffers: &'static [Buffer]) -> Figure {
