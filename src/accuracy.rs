@@ -241,15 +241,7 @@ struct Truth {
 fn reference_hit(objects: &[Object], ray: &Ray) -> Option<Truth> {
     let mut nearest: Option<(f64, usize)> = None;
     for (i, o) in objects.iter().enumerate() {
-        let t = match o.shape {
-            Shape::Sphere(s) => match exact_sphere(&s, ray) {
-                Crossing::Ambiguous => return None,
-                Crossing::Miss => None,
-                Crossing::Hit(t) => Some(t),
-            },
-            Shape::Plane(_) => o.intersect(ray, Method::Stable),
-        };
-        if let Some(t) = t {
+        if let Some(t) = reference_distance(o, ray)? {
             if nearest.is_none_or(|(n, _)| t < n) {
                 nearest = Some((t, i));
             }
@@ -258,6 +250,30 @@ fn reference_hit(objects: &[Object], ray: &Ray) -> Option<Truth> {
     Some(Truth {
         hit: nearest.map(|(_, i)| i),
     })
+}
+
+/// The reference's distance along `ray` to `object`: `Some(None)` for a miss,
+/// `None` when the ray is too close to a sphere's silhouette to judge.
+fn reference_distance(object: &Object, ray: &Ray) -> Option<Option<f64>> {
+    match object.shape {
+        Shape::Sphere(s) => match exact_sphere(&s, ray) {
+            Crossing::Ambiguous => None,
+            Crossing::Miss => Some(None),
+            Crossing::Hit(t) => Some(Some(t)),
+        },
+        Shape::Plane(_) => Some(object.intersect(ray, Method::Stable)),
+    }
+}
+
+/// Is `p` strictly outside the sphere of centre `c` and radius `r`? The sign of
+/// ‖p − c‖² − r², decided in double-double arithmetic.
+pub fn outside_exactly(p: Vec3, c: Vec3, r: f64) -> bool {
+    use dd::Dd;
+    let squares = (0..3).fold(Dd::ZERO, |acc, i| {
+        let d = Dd::diff(p[i], c[i]);
+        acc.add(d.mul(d))
+    });
+    squares.sub(Dd::product(r, r)).value() > 0.0
 }
 
 /// What the exact answer says of a ray and a sphere.
@@ -392,15 +408,7 @@ fn reference_lit(
         if i == index {
             continue;
         }
-        let t = match other.shape {
-            Shape::Sphere(s) => match exact_sphere(&s, &ray) {
-                Crossing::Ambiguous => return None,
-                Crossing::Miss => None,
-                Crossing::Hit(t) => Some(t),
-            },
-            Shape::Plane(_) => other.intersect(&ray, Method::Stable),
-        };
-        if t.is_some_and(|t| t < distance) {
+        if reference_distance(other, &ray)?.is_some_and(|t| t < distance) {
             lit = false;
         }
     }

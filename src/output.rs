@@ -20,16 +20,6 @@ use crate::error::Error;
 /// The name of the EXR file that holds every buffer of a render.
 pub const EXR_FILE: &str = "buffers.exr";
 
-/// Every file name raystep writes in an output folder. Nothing else is touched.
-pub fn owned_files() -> Vec<String> {
-    let mut names: Vec<String> = Buffer::ALL
-        .iter()
-        .map(|b| format!("{}.png", b.name()))
-        .collect();
-    names.push(EXR_FILE.to_string());
-    names
-}
-
 /// Write `frame` into the folder `dir` (created if needed): one PNG per buffer and
 /// [`EXR_FILE`]. All of them are encoded and written to temporary names before any
 /// is renamed into place, and buffer files of an earlier render that this frame

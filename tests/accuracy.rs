@@ -6,7 +6,7 @@ mod common;
 
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
-use raystep::accuracy::{case, measure, Measure, CASES};
+use raystep::accuracy::{case, measure, outside_exactly, Measure, CASES};
 use raystep::ray::Ray;
 use raystep::real::{Precision, Real, Vector};
 use raystep::render::{render, Settings};
@@ -211,34 +211,6 @@ fn the_contact_shadow_is_whole_with_the_auto_offset_and_holed_with_the_fixed_ste
 }
 
 // ---- Property tests: random spheres and rays at scales from 1e-3 to 1e4 ----
-
-/// Exact sign of ‖p − c‖² − r², for float64 inputs, in double-double arithmetic.
-fn outside_exactly(p: Vec3, c: Vec3, r: f64) -> bool {
-    fn two_diff(a: f64, b: f64) -> (f64, f64) {
-        let s = a - b;
-        let bb = a - s;
-        (s, (a - (s + bb)) + (bb - b))
-    }
-    fn square(hi: f64, lo: f64) -> (f64, f64) {
-        let p = hi * hi;
-        let e = hi.mul_add(hi, -p);
-        (p, e + 2.0 * hi * lo + lo * lo)
-    }
-    fn add(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
-        let s = a.0 + b.0;
-        let v = s - a.0;
-        let e = (a.0 - (s - v)) + (b.0 - v);
-        (s, e + a.1 + b.1)
-    }
-    let mut sum = (0.0, 0.0);
-    for i in 0..3 {
-        let (hi, lo) = two_diff(p[i], c[i]);
-        sum = add(sum, square(hi, lo));
-    }
-    let r2 = (r * r, r.mul_add(r, -(r * r)));
-    let diff = add(sum, (-r2.0, -r2.1));
-    diff.0 + diff.1 > 0.0
-}
 
 fn material() -> Material {
     Material {
