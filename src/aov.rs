@@ -12,6 +12,9 @@
 //! | `normal` | `intersection` on | unit world-space normal at the first hit (outward for a sphere, towards the camera for a plane); `(0, 0, 0)` on a miss |
 //! | `shadow` | `intersection` on | `1` lit, `0` in shadow, `−1` on a miss. Before the `shadow` stage is on no shadow ray is cast, so every hit reads `1` |
 
+use crate::camera::Camera;
+use crate::real::{Precision, Vector};
+use crate::render::Rays;
 use crate::Vec3;
 
 /// One buffer, named as its PNG file is.
@@ -74,13 +77,13 @@ pub struct FirstHit {
 }
 // ANCHOR_END: first_hit
 
-/// Everything the render keeps of one pixel, in float32: enough for every buffer.
+/// Everything the render keeps of one pixel, in float32: enough for every buffer
+/// but `direction`, which the camera gives again for any pixel
+/// ([`Frame::direction`]). 32 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PixelRecord {
     /// The beauty colour, clipped to [0, 1].
     pub colour: [f32; 3],
-    /// The primary ray's unit direction.
-    pub direction: [f32; 3],
     /// Distance to the first hit, `+∞` on a miss.
     pub depth: f32,
     /// Unit normal at the first hit, zero on a miss.
@@ -90,16 +93,15 @@ pub struct PixelRecord {
 }
 
 impl PixelRecord {
-    /// The record of a pixel whose primary ray had `direction`, ended with `colour`,
-    /// and whose first hit (if any) was `first`.
-    pub fn new(direction: Vec3, colour: Vec3, first: Option<FirstHit>) -> PixelRecord {
+    /// The record of a pixel that ended with `colour` and whose first hit (if any)
+    /// was `first`.
+    pub fn new(colour: Vec3, first: Option<FirstHit>) -> PixelRecord {
         let (depth, normal, shadow) = match first {
             Some(hit) => (hit.depth, hit.normal, if hit.lit { 1.0 } else { 0.0 }),
             None => (f64::INFINITY, Vec3::ZERO, -1.0),
         };
         PixelRecord {
             colour: colour.as_vec3().to_array(),
-            direction: direction.as_vec3().to_array(),
             depth: depth as f32,
             normal: normal.as_vec3().to_array(),
             shadow,
@@ -121,14 +123,44 @@ pub struct Frame {
     pub height: u32,
     /// Was the `intersection` stage on (so that depth, normal and shadow mean something)?
     pub has_surface_buffers: bool,
+    /// The camera that made the primary rays.
+    pub camera: Camera,
+    /// The precision they were computed in.
+    pub precision: Precision,
+    /// The rays traced for the whole frame.
+    pub rays: Rays,
     /// `width × height` records, row-major, top row first.
     pub pixels: Vec<PixelRecord>,
 }
 
 impl Frame {
+    /// A frame of `camera`'s size with every record blank, to render into.
+    pub fn blank(camera: Camera, precision: Precision) -> Frame {
+        let blank = PixelRecord::new(Vec3::ZERO, None);
+        Frame {
+            width: camera.width,
+            height: camera.height,
+            has_surface_buffers: false,
+            camera,
+            precision,
+            rays: Rays::default(),
+            pixels: vec![blank; camera.width as usize * camera.height as usize],
+        }
+    }
+
     /// The record of pixel (`row`, `col`).
     pub fn at(&self, row: u32, col: u32) -> &PixelRecord {
         &self.pixels[row as usize * self.width as usize + col as usize]
+    }
+
+    /// The unit direction of pixel (`row`, `col`)'s primary ray, computed again as
+    /// the render computed it (the pixel's centre ray, in the frame's precision).
+    pub fn direction(&self, row: u32, col: u32) -> [f32; 3] {
+        let d = match self.precision {
+            Precision::F32 => self.camera.primary_ray::<f32>(row, col).direction.to_f64(),
+            Precision::F64 => self.camera.primary_ray::<f64>(row, col).direction,
+        };
+        d.as_vec3().to_array()
     }
 
     /// The buffers this frame holds, in file order.

@@ -50,7 +50,24 @@ impl Camera {
     /// The point of the screen that pixel (`row` from the top, `col` from the left)
     /// looks at, computed in precision `T`. As in the tutorial, the first and last
     /// pixels sit exactly on the screen's edges: `x = left + col·(right − left)/(W − 1)`.
+    #[inline]
     pub fn screen_point<T: Real>(&self, row: u32, col: u32) -> T::Vec3 {
+        self.screen_point_at::<T>(f64::from(row), f64::from(col))
+    }
+
+    /// The ray from the eye through a position between pixels (for samples).
+    #[inline]
+    pub fn ray_through<T: Real>(&self, row: f64, col: f64) -> Ray<T> {
+        Ray::towards(
+            T::Vec3::of(self.position),
+            self.screen_point_at::<T>(row, col),
+        )
+    }
+
+    /// [`Camera::screen_point`] at a position between pixels too (`row` 2.25 is a
+    /// quarter of the way from row 2 to row 3).
+    #[inline]
+    pub fn screen_point_at<T: Real>(&self, row: f64, col: f64) -> T::Vec3 {
         let s = &self.screen;
         let x = lerp_on_grid(T::of(s.left), T::of(s.right), col, self.width);
         let y = lerp_on_grid(T::of(s.top), T::of(s.bottom), row, self.height);
@@ -58,6 +75,7 @@ impl Camera {
     }
 
     /// The ray from the eye through the pixel's screen point.
+    #[inline]
     pub fn primary_ray<T: Real>(&self, row: u32, col: u32) -> Ray<T> {
         Ray::towards(T::Vec3::of(self.position), self.screen_point::<T>(row, col))
     }
@@ -65,11 +83,12 @@ impl Camera {
 
 /// Sample `i` of `n` evenly spaced values from `from` to `to`, both ends included,
 /// as numpy's `linspace` gives them (a single sample is `from`).
-fn lerp_on_grid<T: Real>(from: T, to: T, i: u32, n: u32) -> T {
+#[inline]
+fn lerp_on_grid<T: Real>(from: T, to: T, i: f64, n: u32) -> T {
     if n < 2 {
         return from;
     }
-    from + T::of(f64::from(i)) * (to - from) / T::of(f64::from(n - 1))
+    from + T::of(i) * (to - from) / T::of(f64::from(n - 1))
 }
 // ANCHOR_END: primary_ray
 

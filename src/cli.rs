@@ -6,6 +6,7 @@ use std::time::Instant;
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use crate::accel::Accel;
 use crate::aov::Frame;
 use crate::error::Error;
 use crate::real::Precision;
@@ -55,6 +56,89 @@ pub enum Command {
     /// a careful float64 reference: false hits and misses, hit points off the
     /// surface, stepped-off origins still inside it, wrong shadows.
     Accuracy(AccuracyArgs),
+    /// Time a frame (render only) against the tutorial's program ported plainly,
+    /// and with one thread against several: seconds per frame, rays and pixels per
+    /// second, peak memory. Default: the built-in scene at 1920 × 1080, every stage.
+    Bench(BenchArgs),
+    /// Write a generated scene as TOML to standard output.
+    Generate(GenerateArgs),
+    /// Chart speed against accuracy for every setting that trades one for the other
+    /// (or, with --scale, time against the number of spheres): a CSV, an SVG and a
+    /// PNG. Default: the built-in scene at 960 × 540.
+    Chart(ChartArgs),
+}
+
+/// Arguments of `raystep chart`.
+#[derive(Args, Debug)]
+pub struct ChartArgs {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub scene: SceneArgs,
+    /// Timed runs of each setting, after one warm-up run.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub runs: u32,
+    /// Chart time against the number of spheres instead, on generated scenes at
+    /// --width × --height (default 1920 × 1080).
+    #[arg(long)]
+    pub scale: bool,
+    /// With --scale, the largest count (powers of ten and their triples up to it).
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..=10_000_000))]
+    pub max_count: u64,
+    /// Where the CSV and the charts go.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+}
+
+/// Arguments of `raystep generate`.
+#[derive(Args, Debug)]
+pub struct GenerateArgs {
+    /// What to generate.
+    #[command(subcommand)]
+    pub what: Generated,
+}
+
+/// The scenes `raystep generate` can write.
+#[derive(Subcommand, Debug)]
+pub enum Generated {
+    /// N spheres resting on the floor, at 1920 × 1080; the radius shrinks as 1/√N.
+    Spheres {
+        /// How many spheres (1 to 100,000: a scene file of 100,000 is 12 MB, near
+        /// the 16 MiB a scene file may be).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+        count: u32,
+        /// The seed of the random numbers: the same seed, the same scene.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+}
+
+/// Arguments of `raystep bench`.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub scene: SceneArgs,
+    /// Turn on every stage up to and including this one.
+    #[arg(long, value_enum, default_value = "plane")]
+    pub stage: Stage,
+    /// Turn one stage off again (repeatable).
+    #[arg(long, value_enum)]
+    pub without: Vec<Stage>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub rules: RuleArgs,
+    /// Threads to render with [default: one per core].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Timed runs of each measurement, after one warm-up run.
+    #[arg(long, default_value_t = 7, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub runs: u32,
+    /// Skip the yardstick (the tutorial's program ported plainly).
+    #[arg(long)]
+    pub no_yardstick: bool,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `raystep accuracy`.
@@ -108,6 +192,29 @@ pub struct RuleArgs {
     /// Most segments per pixel path (overrides the scene's render.max_depth; 1 to 64).
     #[arg(long)]
     pub max_depth: Option<u32>,
+    /// Samples per pixel, a square number from 1 to 1024: stratified over an n × n
+    /// grid, jittered the same way on every run [default: 1, the tutorial's one ray
+    /// per pixel].
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// End a reflection path once what is left of it cannot move a channel by half
+    /// an 8-bit step [default: on; off with --tutorial].
+    #[arg(long, value_enum, value_name = "on|off")]
+    pub early_stop: Option<Switch>,
+    /// How the nearest hit is searched for; never changes a pixel: off (the plain
+    /// loop over every object), auto (tile masks for primary rays, and a BVH from
+    /// 12 spheres on), bvh (always a BVH) [default: auto].
+    #[arg(long, value_enum)]
+    pub accel: Option<Accel>,
+}
+
+/// On or off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Switch {
+    /// On.
+    On,
+    /// Off.
+    Off,
 }
 
 /// Arguments of `raystep stages`.
@@ -181,6 +288,18 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Some(Command::Diff(args)) => diff(&args),
         Some(Command::Figures(args)) => figures(&args),
         Some(Command::Accuracy(args)) => accuracy(&args),
+        Some(Command::Bench(args)) => bench(args),
+        Some(Command::Chart(args)) => chart(args),
+        Some(Command::Generate(args)) => {
+            match args.what {
+                Generated::Spheres { count, seed } => {
+                    use std::io::Write;
+                    let text = crate::generate::spheres_toml(count as usize, seed);
+                    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+                }
+            }
+            Ok(())
+        }
     }
 }
 
@@ -206,12 +325,18 @@ impl RuleArgs {
         } else {
             Settings::from(stages)
         };
+        if let Some(spp) = self.spp {
+            crate::scene_file::check_spp(spp).map_err(Error::Usage)?;
+        }
         Ok(Settings {
             stages,
             precision: self.precision.unwrap_or(base.precision),
             method: self.intersect.unwrap_or(base.method),
             offset: self.offset.unwrap_or(base.offset),
             viewer: self.viewer,
+            accel: self.accel.unwrap_or(base.accel),
+            spp: self.spp.unwrap_or(base.spp),
+            early_stop: self.early_stop.map_or(base.early_stop, |s| s == Switch::On),
         })
     }
 }
@@ -303,6 +428,119 @@ fn write(frame: &Frame, dir: &Path, render_seconds: f64, bar: &ProgressBar) -> R
         )
     });
     Ok(())
+}
+
+fn bench(mut args: BenchArgs) -> Result<(), Error> {
+    if args.scene.scene.is_none() && args.scene.width.is_none() && args.scene.height.is_none() {
+        (args.scene.width, args.scene.height) = (Some(1920), Some(1080));
+    }
+    let stages = Stages::select(args.stage, &args.without).map_err(Error::Usage)?;
+    let (mut scene, name) = load_scene(&args.scene)?;
+    let settings = args.rules.apply(&mut scene, stages)?;
+    let threads = args
+        .threads
+        .map_or_else(rayon::current_num_threads, |t| t as usize);
+    let options = crate::bench::Options {
+        runs: args.runs as usize,
+        threads,
+        yardstick: !args.no_yardstick,
+    };
+    if !args.json {
+        say!("{name}: {}", settings.stages);
+    }
+    let bar = progress_bar(u64::from(args.runs) + 1);
+    bar.set_style(
+        ProgressStyle::with_template("bench [{bar:30}] {pos}/{len} runs, {eta} left")
+            .expect("the template is valid")
+            .progress_chars("=> "),
+    );
+    let report = crate::bench::bench(&scene, &settings, options, &|n| bar.inc(n))?;
+    bar.finish_and_clear();
+    if args.json {
+        let json = serde_json::to_string(&report).expect("a report is always valid JSON");
+        say!("{json}");
+    } else {
+        say!("{}", report.text().trim_end());
+    }
+    Ok(())
+}
+
+fn chart(mut args: ChartArgs) -> Result<(), Error> {
+    ensure_folder(&args.out)?;
+    let runs = args.runs as usize;
+    if args.scale {
+        let size = (
+            args.scene.width.unwrap_or(1920),
+            args.scene.height.unwrap_or(1080),
+        );
+        crate::scene_file::check_image_size((size.0, "--width"), (size.1, "--height"))
+            .map_err(Error::Usage)?;
+        let counts: Vec<usize> = (0..8)
+            .flat_map(|e| [10usize.pow(e), 3 * 10usize.pow(e)])
+            .filter(|&n| n as u64 <= args.max_count)
+            .collect();
+        let plain_up_to = 300;
+        let renders: u64 = counts
+            .iter()
+            .map(|&n| if n <= plain_up_to { 2 } else { 1 } * (args.runs as u64 + 1))
+            .sum();
+        say!(
+            "time against spheres at {} × {}: {} counts",
+            size.0,
+            size.1,
+            counts.len()
+        );
+        let bar = progress_bar(renders);
+        bar.set_style(
+            ProgressStyle::with_template("scale [{bar:30}] {pos}/{len} renders, {eta} left")
+                .expect("the template is valid")
+                .progress_chars("=> "),
+        );
+        let points = crate::chart::scale(&counts, plain_up_to, size, runs, &|n| bar.inc(n));
+        bar.finish_and_clear();
+        let csv = crate::chart::scale_csv(&points);
+        crate::output::write_atomically(&args.out.join("scale.csv"), csv.as_bytes())?;
+        let title = format!("Time against spheres, {} × {}, every stage", size.0, size.1);
+        let files = crate::chart::write_scale(&args.out, "scale", &points, &title)?;
+        say!("{}", csv.trim_end());
+        say!("wrote {}/scale.csv, {}", args.out.display(), names(&files));
+        return Ok(());
+    }
+    if args.scene.scene.is_none() && args.scene.width.is_none() && args.scene.height.is_none() {
+        (args.scene.width, args.scene.height) = (Some(960), Some(540));
+    }
+    let (scene, name) = load_scene(&args.scene)?;
+    say!(
+        "{name}: speed against accuracy at {} × {}",
+        scene.width,
+        scene.height
+    );
+    let bar = progress_bar(crate::chart::sweep_renders(runs));
+    bar.set_style(
+        ProgressStyle::with_template("chart [{bar:30}] {pos}/{len} renders, {eta} left")
+            .expect("the template is valid")
+            .progress_chars("=> "),
+    );
+    let points = crate::chart::sweep(&scene, runs, &|n| bar.inc(n));
+    bar.finish_and_clear();
+    let csv = crate::chart::csv(&points);
+    crate::output::write_atomically(&args.out.join("chart.csv"), csv.as_bytes())?;
+    let title = format!(
+        "Speed against accuracy: {name}, {} × {}",
+        scene.width, scene.height
+    );
+    let files = crate::chart::write_sweep(&args.out, "chart", &points, &title)?;
+    say!("{}", csv.trim_end());
+    say!("wrote {}/chart.csv, {}", args.out.display(), names(&files));
+    Ok(())
+}
+
+fn names(files: &[PathBuf]) -> String {
+    files
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {

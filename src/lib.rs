@@ -40,9 +40,16 @@ pub mod aov;
 pub mod output;
 pub mod render;
 pub mod stages;
+// Speed: skipping tests that cannot succeed.
+pub mod accel;
+pub mod bvh;
 // The command line, its errors, and the tools around the renderer.
 pub mod accuracy;
+pub mod bench;
+pub mod chart;
 pub mod cli;
 pub mod compare;
 pub mod error;
 pub mod figures;
+pub mod generate;
+pub mod yardstick;

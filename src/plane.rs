@@ -19,6 +19,7 @@ impl<T: Real> Plane<T> {
     /// Distance along `ray` to the plane, if the ray crosses it in front of the
     /// origin: `t = ⟨P − O, n⟩ / ⟨d, n⟩`. A ray parallel to the plane misses, and
     /// so does one so nearly parallel that `t` overflows to infinity.
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray<T>) -> Option<T> {
         let zero = T::of(0.0);
         let facing = ray.direction.dot(self.normal);
@@ -31,6 +32,7 @@ impl<T: Real> Plane<T> {
 
     /// The unit normal on the side the ray came from: a plane has two faces and
     /// both are lit the same way.
+    #[inline]
     pub fn normal_towards(&self, ray: &Ray<T>) -> T::Vec3 {
         if ray.direction.dot(self.normal) > T::of(0.0) {
             -self.normal

@@ -18,6 +18,7 @@ pub struct Ray<T: Real = f64> {
 // ANCHOR: ray
 impl<T: Real> Ray<T> {
     /// The ray that starts at `origin` and passes through `target`.
+    #[inline]
     pub fn towards(origin: T::Vec3, target: T::Vec3) -> Ray<T> {
         Ray {
             origin,
@@ -26,6 +27,7 @@ impl<T: Real> Ray<T> {
     }
 
     /// The point at distance `t` along the ray: `O + d·t`.
+    #[inline]
     pub fn at(&self, t: T) -> T::Vec3 {
         self.origin + self.direction * t
     }

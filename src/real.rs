@@ -40,6 +40,8 @@ pub trait Real:
     fn abs(self) -> Self;
     /// `self` to the power `e`.
     fn powf(self, e: Self) -> Self;
+    /// `self` to a whole power, by repeated multiplication.
+    fn powi(self, n: i32) -> Self;
     /// The larger of two.
     fn max(self, other: Self) -> Self;
     /// The smaller of two.
@@ -109,6 +111,9 @@ macro_rules! real {
             }
             fn powf(self, e: $t) -> $t {
                 <$t>::powf(self, e)
+            }
+            fn powi(self, n: i32) -> $t {
+                <$t>::powi(self, n)
             }
             fn max(self, other: $t) -> $t {
                 <$t>::max(self, other)

@@ -5,11 +5,13 @@
 
 use rayon::prelude::*;
 
+use crate::accel::{Accel, TileMasks, BVH_FROM, EVERY};
 use crate::aov::{FirstHit, Frame, PixelRecord};
+use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::ray::Ray;
 use crate::real::{Precision, Real, Vector};
-use crate::scene::{nearest_hit, Light, Object, Scene};
+use crate::scene::{nearest_hit, Hit, Light, Object, Role, Scene};
 use crate::shade::blinn_phong::{self, Viewer};
 use crate::shade::reflection;
 use crate::shade::shadow::{self, Offset};
@@ -33,6 +35,13 @@ pub struct Settings {
     pub offset: Offset,
     /// Who views the highlight on a bounce (`--viewer`; default and tutorial: the camera).
     pub viewer: Viewer,
+    /// How the nearest hit is searched for (`--accel`; never changes a pixel).
+    pub accel: Accel,
+    /// Samples per pixel, a square number (`--spp`; default and tutorial: 1).
+    pub spp: u32,
+    /// End a reflection path once what is left of it cannot change the 8-bit
+    /// pixel (`--early-stop`; default on, tutorial off).
+    pub early_stop: bool,
 }
 
 impl From<Stages> for Settings {
@@ -43,6 +52,9 @@ impl From<Stages> for Settings {
             method: Method::default(),
             offset: Offset::default(),
             viewer: Viewer::default(),
+            accel: Accel::default(),
+            spp: 1,
+            early_stop: true,
         }
     }
 }
@@ -57,6 +69,9 @@ impl Settings {
             method: Method::Naive,
             offset: Offset::TUTORIAL,
             viewer: Viewer::Camera,
+            accel: Accel::default(),
+            spp: 1,
+            early_stop: false,
         }
     }
 }
@@ -80,7 +95,20 @@ pub struct Tracer<T: Real = f64> {
     pub light: Light<T>,
     /// Most segments of a path, when the `reflection` stage is on.
     pub max_depth: u32,
+    /// Samples per pixel (a square number).
+    pub spp: u32,
+    /// For each tile of the image, the objects its primary rays can hit.
+    pub masks: TileMasks,
+    /// The hierarchy over the spheres, for scenes with many of them.
+    pub bvh: Option<Bvh>,
+    /// With early stop on, `reach[k]`: the most that `k` more segments of weight 1
+    /// can add to a channel; empty with early stop off.
+    pub reach: Vec<f64>,
 }
+
+/// Half an 8-bit step: a path whose remaining segments cannot add this much to
+/// any channel is ended early (`--early-stop`).
+pub const HALF_STEP: f64 = 0.5 / 255.0;
 
 /// The colour a ray brings back and what its first hit left for the buffers.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -89,42 +117,160 @@ pub struct Traced {
     pub colour: Vec3,
     /// The first hit, or `None` if the ray hit nothing.
     pub first: Option<FirstHit>,
+    /// The rays this path traced.
+    pub rays: Rays,
+}
+
+/// Rays traced, by kind: what `raystep bench` counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Rays {
+    /// Rays from the camera (one per pixel and sample).
+    pub primary: u64,
+    /// Rays from a hit point towards the light.
+    pub shadow: u64,
+    /// Rays from a hit point in the mirrored direction.
+    pub reflection: u64,
+}
+
+impl Rays {
+    /// Every ray, whatever its kind.
+    pub fn total(&self) -> u64 {
+        self.primary + self.shadow + self.reflection
+    }
+}
+
+impl std::ops::AddAssign for Rays {
+    fn add_assign(&mut self, other: Rays) {
+        self.primary += other.primary;
+        self.shadow += other.shadow;
+        self.reflection += other.reflection;
+    }
 }
 
 impl<T: Real> Tracer<T> {
     /// The tracer of `scene` under `settings`, computing in `T` (the settings'
     /// precision is for [`render`] to choose `T`).
     pub fn new(scene: &Scene, settings: &Settings) -> Tracer<T> {
+        let camera = scene.camera();
+        let objects: Vec<Object<T>> = scene.objects_in_play(settings.stages);
+        let spheres = objects.iter().filter(|o| o.role == Role::Sphere).count();
+        let bvh = match settings.accel {
+            Accel::Off => None,
+            Accel::Auto => (spheres >= BVH_FROM).then(|| Bvh::build(&objects)),
+            Accel::Bvh => Some(Bvh::build(&objects)),
+        };
+        let masks = match settings.accel {
+            Accel::Off => TileMasks::none(),
+            Accel::Auto | Accel::Bvh => TileMasks::new(&camera, &objects),
+        };
+        let reach = if settings.early_stop {
+            reach(&objects, &scene.light, scene.max_depth)
+        } else {
+            Vec::new()
+        };
         Tracer {
             stages: settings.stages,
             method: settings.method,
             offset: settings.offset,
             viewer: settings.viewer,
-            camera: scene.camera(),
-            objects: scene.objects_in_play(settings.stages),
+            camera,
+            objects,
             light: scene.light.cast(),
             max_depth: scene.max_depth,
+            spp: settings.spp,
+            masks,
+            bvh,
+            reach,
+        }
+    }
+
+    /// The nearest object along `ray` among `candidates` (bit `i`: object `i`):
+    /// through the BVH if there is one, else the book's plain loop
+    /// ([`nearest_hit`]), skipping objects outside `candidates`.
+    #[inline]
+    pub fn nearest_hit(&self, ray: &Ray<T>, candidates: u64) -> Option<Hit<T>> {
+        if let Some(bvh) = &self.bvh {
+            return bvh.nearest_hit(&self.objects, ray, self.method);
+        }
+        if candidates == EVERY {
+            return nearest_hit(&self.objects, ray, self.method);
+        }
+        let mut nearest: Option<Hit<T>> = None;
+        let mut left = candidates;
+        while left != 0 {
+            let index = left.trailing_zeros() as usize;
+            left &= left - 1;
+            if let Some(t) = self.objects[index].intersect(ray, self.method) {
+                if nearest.is_none_or(|n| t < n.t) {
+                    nearest = Some(Hit { t, object: index });
+                }
+            }
+        }
+        nearest
+    }
+
+    /// Does the point `shifted` not see the light? [`shadow::in_shadow`], through
+    /// the BVH if there is one.
+    #[inline]
+    pub fn in_shadow(&self, shifted: T::Vec3, to_light: T::Vec3, light_distance: T) -> bool {
+        match &self.bvh {
+            Some(bvh) => {
+                let ray = Ray {
+                    origin: shifted,
+                    direction: to_light,
+                };
+                bvh.blocked(&self.objects, &ray, light_distance, self.method)
+            }
+            None => shadow::in_shadow(
+                &self.objects,
+                shifted,
+                to_light,
+                light_distance,
+                self.method,
+            ),
         }
     }
 
     // ANCHOR: pixel
-    /// The record of pixel (`row`, `col`). With only the `rays` stage on, the colour
-    /// shows the ray's direction: each component mapped from [−1, 1] to [0, 1].
-    pub fn pixel(&self, row: u32, col: u32) -> PixelRecord {
+    /// The record of pixel (`row`, `col`) and the rays it took. With only the
+    /// `rays` stage on, the colour shows the ray's direction: each component mapped
+    /// from [−1, 1] to [0, 1].
+    pub fn pixel(&self, row: u32, col: u32) -> (PixelRecord, Rays) {
         let ray = self.camera.primary_ray::<T>(row, col);
-        let direction = ray.direction.to_f64();
         if !self.stages.intersection {
-            let colour = (direction + Vec3::ONE) * 0.5;
-            return PixelRecord::new(direction, colour, None);
+            let colour = (ray.direction.to_f64() + Vec3::ONE) * 0.5;
+            let rays = Rays {
+                primary: 1,
+                ..Rays::default()
+            };
+            return (PixelRecord::new(colour, None), rays);
         }
-        let traced = self.trace(ray);
-        PixelRecord::new(direction, traced.colour, traced.first)
+        let candidates = self.masks.mask(row, col);
+        let traced = self.trace(ray, candidates);
+        if self.spp == 1 {
+            return (PixelRecord::new(traced.colour, traced.first), traced.rays);
+        }
+        // Several samples: the colour is their mean; the buffers keep the centre
+        // ray's first hit, so they read the same whatever the sample count.
+        let mut rays = traced.rays;
+        let mut sum = Vec3::ZERO;
+        for sample in 0..self.spp {
+            let (y, x) = stratified(row, col, sample, self.spp);
+            let ray = self.camera.ray_through::<T>(y, x);
+            let traced = self.trace(ray, candidates);
+            sum += traced.colour;
+            rays += traced.rays;
+        }
+        let colour = sum / f64::from(self.spp);
+        (PixelRecord::new(colour, traced.first), rays)
     }
     // ANCHOR_END: pixel
 
     // ANCHOR: trace
     /// Follow a ray through the scene, as the tutorial's final program does.
-    pub fn trace(&self, primary: Ray<T>) -> Traced {
+    /// `candidates` holds the objects the primary ray can hit (bit `i` for object
+    /// `i`, [`EVERY`] for all); reflected rays search every object.
+    pub fn trace(&self, primary: Ray<T>, candidates: u64) -> Traced {
         let segments = if self.stages.reflection {
             self.max_depth
         } else {
@@ -134,9 +280,17 @@ impl<T: Real> Tracer<T> {
         let mut weight = T::of(1.0);
         let mut ray = primary;
         let mut first = None;
+        let mut rays = Rays {
+            primary: 1,
+            ..Rays::default()
+        };
         for segment in 0..segments {
+            if segment > 0 {
+                rays.reflection += 1;
+            }
             // The nearest object along the ray; if there is none, the path ends.
-            let Some(hit) = nearest_hit(&self.objects, &ray, self.method) else {
+            let search = if segment == 0 { candidates } else { EVERY };
+            let Some(hit) = self.nearest_hit(&ray, search) else {
                 break;
             };
             let object = &self.objects[hit.object];
@@ -148,14 +302,9 @@ impl<T: Real> Tracer<T> {
             // ANCHOR: shadow_test
             // Shadow: a point that does not see the light ends the path, black.
             let lit = !self.stages.shadow || {
+                rays.shadow += 1;
                 let light_distance = self.light.position.distance(point);
-                !shadow::in_shadow(
-                    &self.objects,
-                    shifted,
-                    to_light,
-                    light_distance,
-                    self.method,
-                )
+                !self.in_shadow(shifted, to_light, light_distance)
             };
             // ANCHOR_END: shadow_test
             if segment == 0 {
@@ -188,51 +337,135 @@ impl<T: Real> Tracer<T> {
             colour += illumination * weight;
             weight = weight * object.material.reflection;
             ray = reflection::reflected_ray(shifted, &ray, normal);
+            // Early stop: nothing the rest of the path adds can change the pixel.
+            let left = (segments - segment - 1) as usize;
+            if self
+                .reach
+                .get(left)
+                .is_some_and(|r| weight.to_f64() * r < HALF_STEP)
+            {
+                break;
+            }
         }
         // The pixel's colour: the sum, clipped to what a screen can show.
         Traced {
             colour: colour.clamp01().to_f64(),
             first,
+            rays,
         }
         // ANCHOR_END: accumulate
     }
     // ANCHOR_END: trace
 }
 
+/// The most that `k` more segments can add to a channel, for `k` from 0 to
+/// `max_depth`, when each segment's weight is 1: segment `i` adds at most
+/// `ρⁱ · B`, with `B` the largest `|ka·la| + |kd·ld| + |ks·ls|` of any object and
+/// channel (every Blinn-Phong factor is at most 1 in size) and `ρ` the largest
+/// reflection.
+fn reach<T: Real>(objects: &[Object<T>], light: &Light, max_depth: u32) -> Vec<f64> {
+    let mut most = 0.0f64;
+    let mut mirror = 0.0f64;
+    for o in objects {
+        let m = o.exact().material;
+        let term = (m.ambient * light.ambient).abs()
+            + (m.diffuse * light.diffuse).abs()
+            + (m.specular * light.specular).abs();
+        most = most.max(term.max_element());
+        mirror = mirror.max(m.reflection.abs());
+    }
+    let mut reach = vec![0.0; max_depth as usize + 1];
+    for k in 1..reach.len() {
+        reach[k] = most + mirror * reach[k - 1];
+    }
+    reach
+}
+
+/// Sample `sample` of `spp` (a square, n × n) in pixel (`row`, `col`): the centre
+/// of one cell of an n × n grid over the pixel, moved by a jitter within the cell.
+/// The jitter comes from a hash of the pixel and the sample, so every render gives
+/// the same samples. Returns the position in fractional rows and columns.
+pub fn stratified(row: u32, col: u32, sample: u32, spp: u32) -> (f64, f64) {
+    let n = spp.isqrt();
+    let (sy, sx) = (sample / n, sample % n);
+    let bits = splitmix64(u64::from(row) << 40 ^ u64::from(col) << 20 ^ u64::from(sample));
+    let unit = |b: u64| (b >> 11) as f64 / (1u64 << 53) as f64;
+    let (jy, jx) = (unit(bits), unit(splitmix64(bits)));
+    let n = f64::from(n);
+    (
+        f64::from(row) - 0.5 + (f64::from(sy) + jy) / n,
+        f64::from(col) - 0.5 + (f64::from(sx) + jx) / n,
+    )
+}
+
+/// SplitMix64 (Steele, Lea and Flood, 2014): a 64-bit hash whose outputs pass
+/// the usual statistical tests; one step of it turns a pixel's coordinates into
+/// its jitter.
+pub fn splitmix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
 // ANCHOR: render
 /// Render `scene` under `settings`. `progress(1)` is called, from any thread, each
 /// time a row is finished.
 pub fn render(scene: &Scene, settings: &Settings, progress: &(dyn Fn(u64) + Sync)) -> Frame {
+    let mut frame = Frame::blank(scene.camera(), settings.precision);
+    render_into(scene, settings, &mut frame, progress);
+    frame
+}
+
+/// [`render`] into a frame of the scene's size that is already allocated (as
+/// `raystep bench` does, to time the render alone).
+pub fn render_into(
+    scene: &Scene,
+    settings: &Settings,
+    frame: &mut Frame,
+    progress: &(dyn Fn(u64) + Sync),
+) {
     match settings.precision {
-        Precision::F32 => render_in::<f32>(scene, settings, progress),
-        Precision::F64 => render_in::<f64>(scene, settings, progress),
+        Precision::F32 => render_in::<f32>(scene, settings, frame, progress),
+        Precision::F64 => render_in::<f64>(scene, settings, frame, progress),
     }
 }
 
-/// [`render`], computing in `T`.
-pub fn render_in<T: Real>(
+/// [`render_into`], computing in `T`: rows in parallel, each pixel on its own.
+fn render_in<T: Real>(
     scene: &Scene,
     settings: &Settings,
+    frame: &mut Frame,
     progress: &(dyn Fn(u64) + Sync),
-) -> Frame {
+) {
     let tracer = Tracer::<T>::new(scene, settings);
     let width = scene.width as usize;
-    let mut pixels =
-        vec![PixelRecord::new(Vec3::ZERO, Vec3::ZERO, None); width * scene.height as usize];
-    pixels
+    assert_eq!(
+        frame.pixels.len(),
+        width * scene.height as usize,
+        "frame size"
+    );
+    let rays = frame
+        .pixels
         .par_chunks_mut(width)
         .enumerate()
-        .for_each(|(row, line)| {
+        .map(|(row, line)| {
+            let mut rays = Rays::default();
             for (col, pixel) in line.iter_mut().enumerate() {
-                *pixel = tracer.pixel(row as u32, col as u32);
+                let (record, taken) = tracer.pixel(row as u32, col as u32);
+                *pixel = record;
+                rays += taken;
             }
             progress(1);
+            rays
+        })
+        .reduce(Rays::default, |mut a, b| {
+            a += b;
+            a
         });
-    Frame {
-        width: scene.width,
-        height: scene.height,
-        has_surface_buffers: settings.stages.intersection,
-        pixels,
-    }
+    frame.has_surface_buffers = settings.stages.intersection;
+    frame.camera = tracer.camera;
+    frame.precision = settings.precision;
+    frame.rays = rays;
 }
 // ANCHOR_END: render

@@ -137,6 +137,7 @@ pub struct Hit<T: Real = f64> {
 // ANCHOR: nearest_hit
 impl<T: Real> Object<T> {
     /// Distance along `ray` to this object, if it is hit (spheres by `method`).
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray<T>, method: Method) -> Option<T> {
         match &self.shape {
             Shape::Sphere(s) => s.intersect(ray, method),
@@ -145,6 +146,7 @@ impl<T: Real> Object<T> {
     }
 
     /// The unit normal at the point `p` where `ray` hit this object.
+    #[inline]
     pub fn normal_at(&self, p: T::Vec3, ray: &Ray<T>) -> T::Vec3 {
         match &self.shape {
             Shape::Sphere(s) => s.normal_at(p),
@@ -154,6 +156,7 @@ impl<T: Real> Object<T> {
 }
 
 /// The first object along `ray`: test them all, keep the smallest distance.
+#[inline]
 pub fn nearest_hit<T: Real>(objects: &[Object<T>], ray: &Ray<T>, method: Method) -> Option<Hit<T>> {
     let mut nearest: Option<Hit<T>> = None;
     for (index, object) in objects.iter().enumerate() {
@@ -168,6 +171,7 @@ pub fn nearest_hit<T: Real>(objects: &[Object<T>], ray: &Ray<T>, method: Method)
 
 /// Is any object hit along `ray` closer than `distance`? The shadow test needs
 /// only a yes or a no, so it stops at the first blocker it finds.
+#[inline]
 pub fn blocked<T: Real>(objects: &[Object<T>], ray: &Ray<T>, distance: T, method: Method) -> bool {
     objects
         .iter()
@@ -178,6 +182,7 @@ pub fn blocked<T: Real>(objects: &[Object<T>], ray: &Ray<T>, distance: T, method
 impl<T: Real> Object<T> {
     /// The point of the surface nearest to `p`, a point computed to be on it:
     /// moved along the sphere's radius, or along the plane's normal.
+    #[inline]
     pub fn project(&self, p: T::Vec3) -> T::Vec3 {
         match &self.shape {
             Shape::Sphere(s) => s.center + (p - s.center).normalize() * s.radius,
@@ -185,9 +190,22 @@ impl<T: Real> Object<T> {
         }
     }
 
+    /// [`Object::project`] of a point `p` whose unit normal `normal` is already
+    /// known: for a sphere `C + N·r` (the normal is the direction from the centre
+    /// to `p`, so this is the same number without a second square root), for a
+    /// plane the same as `project`.
+    #[inline]
+    pub fn surface_point(&self, p: T::Vec3, normal: T::Vec3) -> T::Vec3 {
+        match &self.shape {
+            Shape::Sphere(s) => s.center + normal * s.radius,
+            Shape::Plane(_) => self.project(p),
+        }
+    }
+
     /// The size of the numbers this surface is computed from (the largest
     /// coordinate of the centre plus the radius, or of the plane's point): rounding
     /// errors of anything computed on it grow with this.
+    #[inline]
     pub fn magnitude(&self) -> T {
         match &self.shape {
             Shape::Sphere(s) => s.center.max_abs() + s.radius,

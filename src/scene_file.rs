@@ -152,6 +152,27 @@ pub fn check_max_depth(max_depth: u32, source: &str) -> Result<(), String> {
     }
 }
 
+/// Most samples per pixel (`--spp`): 32 × 32.
+pub const MAX_SPP: u32 = 1024;
+
+/// Refuse a sample count that is not a square from 1 to [`MAX_SPP`] (the samples
+/// of a pixel form an n × n grid of strata).
+pub fn check_spp(spp: u32) -> Result<(), String> {
+    let n = spp.isqrt();
+    if !(1..=MAX_SPP).contains(&spp) {
+        Err(format!("--spp {spp}: must be from 1 to {MAX_SPP}"))
+    } else if n * n != spp {
+        Err(format!(
+            "--spp {spp}: must be a square number (1, 4, 9, 16, …), so that the samples \
+             form an n × n grid over the pixel; the nearest are {} and {}",
+            n * n,
+            (n + 1) * (n + 1)
+        ))
+    } else {
+        Ok(())
+    }
+}
+
 /// Three numbers `[x, y, z]`: exactly three, so that a fourth is an error, not
 /// silently dropped.
 #[derive(Clone, Copy, Debug)]

@@ -40,6 +40,7 @@ impl<T: Real> Sphere<T> {
     /// the sphere counts only when the ray crosses it twice (Δ > 0; a ray that only
     /// touches it does not count) and both crossings are in front of the origin. The
     /// smaller root is the distance.
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray<T>, method: Method) -> Option<T> {
         let (near, far) = match method {
             Method::Naive => self.roots_naive(ray)?,
@@ -50,6 +51,7 @@ impl<T: Real> Sphere<T> {
     }
 
     /// The outward unit normal at a point `p` on the surface.
+    #[inline]
     pub fn normal_at(&self, p: T::Vec3) -> T::Vec3 {
         (p - self.center).normalize()
     }
@@ -60,6 +62,7 @@ impl<T: Real> Sphere<T> {
 impl<T: Real> Sphere<T> {
     /// The two roots of `t² + b·t + c = 0`, smaller first, if Δ > 0: the textbook
     /// way. `b = 2⟨d, O − C⟩`, `c = ‖O − C‖² − r²`, `Δ = b² − 4c`, `t = (−b ± √Δ)/2`.
+    #[inline(always)]
     pub fn roots_naive(&self, ray: &Ray<T>) -> Option<(T, T)> {
         let (two, four) = (T::of(2.0), T::of(4.0));
         let oc = ray.origin - self.center;
@@ -92,6 +95,7 @@ impl<T: Real> Sphere<T> {
     ///
     /// `q = h + sign(h)·√(Δ/4)` adds two numbers of one sign; the other root is
     /// `c/q`, because the product of the roots is `c`.
+    #[inline(always)]
     pub fn roots_stable(&self, ray: &Ray<T>) -> Option<(T, T)> {
         let f = ray.origin - self.center;
         let h = -ray.direction.dot(f);

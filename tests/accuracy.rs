@@ -396,6 +396,10 @@ proptest! {
         for p in &frame.pixels {
             check_pixel(p)?;
         }
+        for (row, col) in [(0, 0), (frame.height - 1, frame.width - 1)] {
+            let d = frame.direction(row, col);
+            prop_assert!(d.iter().all(|c| c.is_finite()), "{:?}", d);
+        }
     }
 }
 
@@ -408,7 +412,6 @@ fn check_pixel(p: &raystep::aov::PixelRecord) -> Result<(), TestCaseError> {
         "{:?}",
         p
     );
-    prop_assert!(p.direction.iter().all(|c| c.is_finite()), "{:?}", p);
     prop_assert!(p.normal.iter().all(|c| c.is_finite()), "{:?}", p);
     if p.shadow == -1.0 {
         prop_assert!(

@@ -27,6 +27,7 @@ pub enum Viewer {
 /// the light). `N·H` is clamped at 0 before the power: a negative base with a
 /// fractional exponent would give NaN, and on the tutorial's scene the clamp moves
 /// no pixel by more than 3e-12.
+#[inline]
 pub fn illuminate<T: Real>(
     material: &Material<T>,
     light: &Light<T>,
@@ -37,14 +38,27 @@ pub fn illuminate<T: Real>(
     let ambient = material.ambient * light.ambient;
     let diffuse = material.diffuse * light.diffuse * to_light.dot(normal);
     let half = (to_light + to_viewer).normalize();
-    let highlight = normal
-        .dot(half)
-        .max(T::of(0.0))
-        .powf(material.shininess / T::of(4.0));
+    let highlight = power(
+        normal.dot(half).max(T::of(0.0)),
+        material.shininess / T::of(4.0),
+    );
     let specular = material.specular * light.specular * highlight;
     ambient + diffuse + specular
 }
 // ANCHOR_END: illuminate
+
+/// `x` to the power `e`, `x ≥ 0`. A whole exponent up to 256 (the tutorial's
+/// shininess 100 gives 25) is computed by repeated squaring, several times faster
+/// than the general `powf` and within a few units in the last place of it.
+#[inline]
+pub fn power<T: Real>(x: T, e: T) -> T {
+    let whole = e.to_f64();
+    if whole.fract() == 0.0 && (0.0..=256.0).contains(&whole) {
+        x.powi(whole as i32)
+    } else {
+        x.powf(e)
+    }
+}
 
 #[cfg(test)]
 mod tests {

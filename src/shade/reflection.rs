@@ -5,12 +5,14 @@ use crate::real::{Real, Vector};
 
 // ANCHOR: reflect
 /// The direction `d` mirrored about the unit normal `n`: `d − 2(d·n)n`.
+#[inline]
 pub fn reflect<T: Real>(direction: T::Vec3, normal: T::Vec3) -> T::Vec3 {
     direction - normal * (T::of(2.0) * direction.dot(normal))
 }
 
 /// The ray that continues the path: from the moved hit point `shifted`, along the
 /// mirrored direction.
+#[inline]
 pub fn reflected_ray<T: Real>(shifted: T::Vec3, incoming: &Ray<T>, normal: T::Vec3) -> Ray<T> {
     Ray {
         origin: shifted,

@@ -72,6 +72,7 @@ impl std::fmt::Display for Offset {
 /// The hit point moved a little along the surface normal. A ray cast from the
 /// exact hit point could find the same surface again at a tiny distance, because
 /// the computed point lies a rounding error inside or outside it ("shadow acne").
+#[inline]
 pub fn step_off<T: Real>(
     point: T::Vec3,
     normal: T::Vec3,
@@ -81,7 +82,7 @@ pub fn step_off<T: Real>(
     match offset {
         Offset::Fixed(step) => point + normal * T::of(step),
         Offset::Auto => {
-            let on_surface = surface.project(point);
+            let on_surface = surface.surface_point(point, normal);
             let scale = surface.magnitude().max(on_surface.max_abs());
             let bound = T::of(AUTO_FACTOR) * T::UNIT_ROUNDOFF * scale;
             on_surface + normal * bound
@@ -95,6 +96,7 @@ pub fn step_off<T: Real>(
 /// light (`to_light`, a unit vector). The point is in shadow if an object is hit
 /// closer than the light, whose distance `light_distance` is measured from the
 /// original hit point.
+#[inline]
 pub fn in_shadow<T: Real>(
     objects: &[Object<T>],
     shifted: T::Vec3,

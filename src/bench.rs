@@ -1,0 +1,223 @@
+//! `raystep bench`: how fast a frame renders, against a yardstick, in one run.
+//!
+//! Three things are timed, their runs interleaved so that a noisy machine slows
+//! all of them alike: raystep with the threads asked for, raystep with one thread,
+//! and the [yardstick](crate::yardstick) (the tutorial's program ported plainly)
+//! with the same threads as raystep. Each is rendered once to warm up, then
+//! `runs` times; the median of the runs is reported. Only the render is timed:
+//! the frame is allocated once, before the runs, and no file is written.
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::aov::Frame;
+use crate::error::Error;
+use crate::render::{render_into, Rays, Settings};
+use crate::scene::Scene;
+use crate::yardstick::Yardstick;
+
+/// What `raystep bench` reports (its `--json` output).
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Threads raystep and the yardstick rendered with.
+    pub threads: usize,
+    /// Timed runs of each measurement.
+    pub runs: usize,
+    /// Median seconds per frame, render only, with `threads` threads.
+    pub median_s: f64,
+    /// Rays per frame, all kinds.
+    pub rays: u64,
+    /// Rays per frame from the camera.
+    pub rays_primary: u64,
+    /// Rays per frame towards the light.
+    pub rays_shadow: u64,
+    /// Rays per frame in mirrored directions.
+    pub rays_reflection: u64,
+    /// `rays / median_s`.
+    pub rays_per_s: f64,
+    /// `width · height / median_s`.
+    pub pixels_per_s: f64,
+    /// Median seconds per frame with one thread (absent when `threads` is 1).
+    pub one_thread_median_s: Option<f64>,
+    /// `one_thread_median_s / median_s`.
+    pub thread_speedup: Option<f64>,
+    /// Median seconds per frame of the yardstick (absent for a scene with a true
+    /// plane, which the tutorial's program cannot draw, or with `--no-yardstick`).
+    pub yardstick_median_s: Option<f64>,
+    /// `yardstick_median_s / median_s`: how many times faster raystep is.
+    pub yardstick_ratio: Option<f64>,
+    /// Peak resident memory of the process so far, in bytes (Linux only).
+    pub peak_memory_bytes: Option<u64>,
+}
+
+/// How to bench.
+#[derive(Clone, Copy, Debug)]
+pub struct Options {
+    /// Timed runs of each measurement (after one warm-up run).
+    pub runs: usize,
+    /// Threads for raystep and the yardstick.
+    pub threads: usize,
+    /// Time the yardstick too.
+    pub yardstick: bool,
+}
+
+/// A timed thing: a name for messages and a closure that renders one frame.
+type Job<'a> = Box<dyn FnMut() + 'a>;
+
+/// Bench `scene` under `settings`. `progress(1)` is called after every run.
+pub fn bench(
+    scene: &Scene,
+    settings: &Settings,
+    options: Options,
+    progress: &dyn Fn(u64),
+) -> Result<Report, Error> {
+    let pool = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| Error::Usage(format!("cannot start {threads} threads: {e}")))
+    };
+    let (many, one) = (pool(options.threads)?, pool(1)?);
+    let yardstick = options.yardstick.then(|| Yardstick::new(scene)).flatten();
+
+    let mut frame = Frame::blank(scene.camera(), settings.precision);
+    let mut one_frame = frame.clone();
+    let mut rays = Rays::default();
+    let mut image = Vec::new();
+    let mut jobs: Vec<Job> = vec![Box::new(|| {
+        many.install(|| render_into(scene, settings, &mut frame, &|_| {}));
+        rays = frame.rays;
+    })];
+    if options.threads > 1 {
+        jobs.push(Box::new(|| {
+            one.install(|| render_into(scene, settings, &mut one_frame, &|_| {}))
+        }));
+    }
+    if let Some(y) = &yardstick {
+        jobs.push(Box::new(|| many.install(|| y.render_into(&mut image))));
+    }
+    let mut seconds = vec![Vec::with_capacity(options.runs); jobs.len()];
+    for run in 0..=options.runs {
+        for (job, times) in jobs.iter_mut().zip(&mut seconds) {
+            let start = Instant::now();
+            job();
+            if run > 0 {
+                times.push(start.elapsed().as_secs_f64());
+            }
+        }
+        progress(1);
+    }
+    drop(jobs);
+
+    let mut medians = seconds.into_iter().map(median);
+    let median_s = medians.next().expect("raystep is always timed");
+    let one_thread_median_s = (options.threads > 1).then(|| medians.next()).flatten();
+    let yardstick_median_s = yardstick.is_some().then(|| medians.next()).flatten();
+    let pixels = f64::from(scene.width) * f64::from(scene.height);
+    Ok(Report {
+        width: scene.width,
+        height: scene.height,
+        threads: options.threads,
+        runs: options.runs,
+        median_s,
+        rays: rays.total(),
+        rays_primary: rays.primary,
+        rays_shadow: rays.shadow,
+        rays_reflection: rays.reflection,
+        rays_per_s: rays.total() as f64 / median_s,
+        pixels_per_s: pixels / median_s,
+        one_thread_median_s,
+        thread_speedup: one_thread_median_s.map(|t| t / median_s),
+        yardstick_median_s,
+        yardstick_ratio: yardstick_median_s.map(|t| t / median_s),
+        peak_memory_bytes: peak_memory_bytes(),
+    })
+}
+
+/// The median of some times (the mean of the middle two for an even count).
+pub fn median(mut times: Vec<f64>) -> f64 {
+    times.sort_by(f64::total_cmp);
+    let n = times.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    if n % 2 == 1 {
+        times[n / 2]
+    } else {
+        (times[n / 2 - 1] + times[n / 2]) / 2.0
+    }
+}
+
+/// The peak resident memory of this process, from `/proc/self/status` (`VmHWM`).
+pub fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+impl Report {
+    /// The report as a person reads it.
+    pub fn text(&self) -> String {
+        let mut out = String::new();
+        let mut line = |s: String| {
+            out.push_str(&s);
+            out.push('\n');
+        };
+        line(format!(
+            "{} × {}, {} thread{}, median of {} runs",
+            self.width,
+            self.height,
+            self.threads,
+            if self.threads == 1 { "" } else { "s" },
+            self.runs
+        ));
+        line(format!(
+            "  render      {:>9.4} s per frame   {:>7.1} Mpixel/s   {:>7.1} Mray/s",
+            self.median_s,
+            self.pixels_per_s / 1e6,
+            self.rays_per_s / 1e6
+        ));
+        line(format!(
+            "  rays        {:>9} per frame: {} primary, {} shadow, {} reflection",
+            self.rays, self.rays_primary, self.rays_shadow, self.rays_reflection
+        ));
+        if let (Some(t), Some(s)) = (self.one_thread_median_s, self.thread_speedup) {
+            line(format!(
+                "  1 thread    {t:>9.4} s per frame   {} threads are {s:.2}× faster",
+                self.threads
+            ));
+        }
+        match (self.yardstick_median_s, self.yardstick_ratio) {
+            (Some(t), Some(r)) => line(format!(
+                "  yardstick   {t:>9.4} s per frame   raystep is {r:.2}× faster \
+                 (the tutorial's program ported plainly, {} threads)",
+                self.threads
+            )),
+            _ => {
+                line("  yardstick   not run (a scene with a true plane, or --no-yardstick)".into())
+            }
+        }
+        if let Some(bytes) = self.peak_memory_bytes {
+            line(format!("  peak memory {:>9.1} MB", bytes as f64 / 1e6));
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_median_takes_the_middle() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert!(median(vec![]).is_nan());
+    }
+}

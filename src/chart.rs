@@ -1,0 +1,624 @@
+//! `raystep chart`: what each setting costs in time and buys in accuracy, in one
+//! picture; and how the cost grows with the number of spheres.
+//!
+//! **Speed against accuracy.** Every setting that trades one for the other is
+//! rendered on the same scene: precision, intersection method, offset, samples
+//! per pixel, `max_depth`, early stop, acceleration. Accuracy is the beauty's error
+//! against a reference render of the same scene made with every careful choice
+//! (float64, the stable method, the automatic offset, 64 samples per pixel, 16
+//! segments, no early stop): the root mean square error and the worst pixel, in
+//! 8-bit levels. Speed is the median time per frame of the render alone, the runs
+//! of all settings interleaved so that a noisy machine slows all of them alike.
+//! A setting is on the Pareto frontier when no other setting is both faster and
+//! more accurate.
+//!
+//! **Scale.** Generated scenes of N spheres ([`crate::generate`]) at the chart's
+//! size, rendered with `--accel auto` and with the plain loop (`--accel off`, up to
+//! the count where it becomes too slow to wait for).
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+
+use crate::accel::Accel;
+use crate::aov::Frame;
+use crate::bench::median;
+use crate::error::Error;
+use crate::real::Precision;
+use crate::render::{render_into, Settings};
+use crate::scene::Scene;
+use crate::shade::shadow::Offset;
+use crate::sphere::Method;
+use crate::stages::Stages;
+
+/// The font of the PNG charts, built in so that no system font is needed
+/// (DejaVu Sans; its licence is in `assets/DejaVuSans-LICENSE.txt`).
+const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+
+/// One setting of the sweep, measured.
+#[derive(Clone, Debug)]
+pub struct Point {
+    /// Short name, drawn beside the point.
+    pub label: String,
+    /// Median seconds per frame (render only).
+    pub median_s: f64,
+    /// Root mean square error of the beauty against the reference, 8-bit levels.
+    pub rmse: f64,
+    /// Largest error of any channel of any pixel, 8-bit levels.
+    pub worst: f64,
+    /// Is this raystep's default?
+    pub default: bool,
+    /// Is it on the Pareto frontier?
+    pub frontier: bool,
+}
+
+/// A setting to measure: a label, the settings, and a `max_depth`.
+struct Config {
+    label: &'static str,
+    settings: Settings,
+    max_depth: u32,
+}
+
+/// The settings the chart compares: the default, and one change from it each (and
+/// the tutorial's program).
+fn configs(max_depth: u32) -> Vec<Config> {
+    let default = Settings::from(Stages::ALL);
+    let with = |label, change: &dyn Fn(&mut Settings)| {
+        let mut settings = default;
+        change(&mut settings);
+        Config {
+            label,
+            settings,
+            max_depth,
+        }
+    };
+    let depth = |label, depth: u32, early_stop: bool| Config {
+        label,
+        settings: Settings {
+            early_stop,
+            ..default
+        },
+        max_depth: depth,
+    };
+    vec![
+        with("default", &|_| {}),
+        Config {
+            label: "tutorial",
+            settings: Settings::tutorial(Stages::ALL),
+            max_depth,
+        },
+        with("f32", &|s| s.precision = Precision::F32),
+        with("naive", &|s| s.method = Method::Naive),
+        with("fixed:1e-5", &|s| s.offset = Offset::TUTORIAL),
+        with("accel off", &|s| s.accel = Accel::Off),
+        with("early stop off", &|s| s.early_stop = false),
+        with("spp 4", &|s| s.spp = 4),
+        with("spp 16", &|s| s.spp = 16),
+        with("spp 4, f32", &|s| {
+            s.spp = 4;
+            s.precision = Precision::F32;
+        }),
+        depth("depth 1", 1, true),
+        depth("depth 2", 2, true),
+        depth("depth 16", 16, true),
+        depth("depth 16, no early stop", 16, false),
+    ]
+}
+
+/// The reference: every careful choice.
+pub fn reference_settings() -> (Settings, u32) {
+    let settings = Settings {
+        precision: Precision::F64,
+        method: Method::Stable,
+        offset: Offset::Auto,
+        spp: 64,
+        early_stop: false,
+        ..Settings::from(Stages::ALL)
+    };
+    (settings, 16)
+}
+
+/// Measure every setting on `scene`, `runs` timed runs each after a warm-up.
+/// `progress(1)` is called after each render.
+pub fn sweep(scene: &Scene, runs: usize, progress: &dyn Fn(u64)) -> Vec<Point> {
+    let configs = configs(scene.max_depth);
+    let (reference_settings, reference_depth) = reference_settings();
+    let reference = render_at(scene, &reference_settings, reference_depth);
+    progress(1);
+    let mut frames: Vec<Frame> = configs
+        .iter()
+        .map(|c| Frame::blank(scene.camera(), c.settings.precision))
+        .collect();
+    let scenes: Vec<Scene> = configs
+        .iter()
+        .map(|c| Scene {
+            max_depth: c.max_depth,
+            ..scene.clone()
+        })
+        .collect();
+    let mut times = vec![Vec::with_capacity(runs); configs.len()];
+    for run in 0..=runs {
+        for (i, c) in configs.iter().enumerate() {
+            let start = Instant::now();
+            render_into(&scenes[i], &c.settings, &mut frames[i], &|_| {});
+            if run > 0 {
+                times[i].push(start.elapsed().as_secs_f64());
+            }
+            progress(1);
+        }
+    }
+    let mut points: Vec<Point> = configs
+        .iter()
+        .zip(frames)
+        .zip(times)
+        .map(|((c, frame), times)| {
+            let (rmse, worst) = error(&frame, &reference);
+            Point {
+                label: c.label.to_string(),
+                median_s: median(times),
+                rmse,
+                worst,
+                default: c.label == "default",
+                frontier: false,
+            }
+        })
+        .collect();
+    mark_frontier(&mut points);
+    points
+}
+
+/// Render `scene` with `settings` and `max_depth`.
+fn render_at(scene: &Scene, settings: &Settings, max_depth: u32) -> Frame {
+    let scene = Scene {
+        max_depth,
+        ..scene.clone()
+    };
+    crate::render::render(&scene, settings, &|_| {})
+}
+
+/// Renders needed by [`sweep`] with `runs` runs: the reference, then a warm-up and
+/// `runs` of each setting.
+pub fn sweep_renders(runs: usize) -> u64 {
+    1 + (configs(1).len() * (runs + 1)) as u64
+}
+
+/// The beauty's error against `reference`: (root mean square, worst), in 8-bit
+/// levels (1 level = 1/255).
+pub fn error(frame: &Frame, reference: &Frame) -> (f64, f64) {
+    let mut sum = 0.0;
+    let mut worst = 0.0f64;
+    for (a, b) in frame.pixels.iter().zip(&reference.pixels) {
+        for c in 0..3 {
+            let d = f64::from(a.colour[c]) - f64::from(b.colour[c]);
+            sum += d * d;
+            worst = worst.max(d.abs());
+        }
+    }
+    let n = (frame.pixels.len() * 3).max(1) as f64;
+    ((sum / n).sqrt() * 255.0, worst * 255.0)
+}
+
+/// Mark the points that no other point beats on both time and error.
+pub fn mark_frontier(points: &mut [Point]) {
+    for i in 0..points.len() {
+        let p = &points[i];
+        let beaten = points.iter().any(|q| {
+            q.median_s <= p.median_s
+                && q.rmse <= p.rmse
+                && (q.median_s < p.median_s || q.rmse < p.rmse)
+        });
+        points[i].frontier = !beaten;
+    }
+}
+
+/// The points as CSV.
+pub fn csv(points: &[Point]) -> String {
+    let mut out = String::from("setting,median_ms,rmse_levels,worst_levels,default,frontier\n");
+    for p in points {
+        let _ = writeln!(
+            out,
+            "{},{:.3},{:.4},{:.2},{},{}",
+            p.label,
+            p.median_s * 1e3,
+            p.rmse,
+            p.worst,
+            p.default,
+            p.frontier
+        );
+    }
+    out
+}
+
+/// One measurement of the scale sweep.
+#[derive(Clone, Debug)]
+pub struct ScalePoint {
+    /// Spheres in the scene.
+    pub count: usize,
+    /// How the nearest hit was searched for.
+    pub accel: Accel,
+    /// Median seconds per frame (render only, BVH build included).
+    pub median_s: f64,
+    /// Seconds to build the BVH alone (0 without one).
+    pub build_s: f64,
+    /// Bytes of the BVH.
+    pub bvh_bytes: usize,
+}
+
+/// Render generated scenes of each count in `counts` at `width × height`, with
+/// `--accel auto` and, up to `plain_up_to` spheres, `--accel off`.
+pub fn scale(
+    counts: &[usize],
+    plain_up_to: usize,
+    (width, height): (u32, u32),
+    runs: usize,
+    progress: &dyn Fn(u64),
+) -> Vec<ScalePoint> {
+    let mut points = Vec::new();
+    for &count in counts {
+        let mut scene = crate::generate::scene(count, 1);
+        (scene.width, scene.height) = (width, height);
+        let objects: Vec<crate::scene::Object> = scene.objects_in_play(Stages::ALL);
+        let start = Instant::now();
+        let bvh = crate::bvh::Bvh::build(&objects);
+        let build_s = start.elapsed().as_secs_f64();
+        for accel in [Accel::Auto, Accel::Off] {
+            if accel == Accel::Off && count > plain_up_to {
+                continue;
+            }
+            let settings = Settings {
+                accel,
+                ..Settings::from(Stages::ALL)
+            };
+            let mut frame = Frame::blank(scene.camera(), settings.precision);
+            let mut times = Vec::new();
+            for run in 0..=runs {
+                let start = Instant::now();
+                render_into(&scene, &settings, &mut frame, &|_| {});
+                if run > 0 {
+                    times.push(start.elapsed().as_secs_f64());
+                }
+                progress(1);
+            }
+            let uses_bvh = accel == Accel::Auto && count >= crate::accel::BVH_FROM;
+            points.push(ScalePoint {
+                count,
+                accel,
+                median_s: median(times),
+                build_s: if uses_bvh { build_s } else { 0.0 },
+                bvh_bytes: if uses_bvh { bvh.bytes() } else { 0 },
+            });
+        }
+    }
+    points
+}
+
+/// The scale points as CSV.
+pub fn scale_csv(points: &[ScalePoint]) -> String {
+    let mut out = String::from("spheres,accel,median_ms,bvh_build_ms,bvh_bytes\n");
+    for p in points {
+        let _ = writeln!(
+            out,
+            "{},{},{:.3},{:.3},{}",
+            p.count,
+            p.accel,
+            p.median_s * 1e3,
+            p.build_s * 1e3,
+            p.bvh_bytes
+        );
+    }
+    out
+}
+
+/// Make the built-in font the charts' "sans-serif" (once).
+fn register_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+            .unwrap_or_else(|_| panic!("the built-in font is a valid TrueType font"));
+    });
+}
+
+/// Chart size in pixels.
+const SIZE: (u32, u32) = (960, 640);
+
+/// Something that draws a chart as SVG.
+type DrawSvg<'a> = dyn for<'b> Fn(&DrawingArea<SVGBackend<'b>, Shift>) -> Result<(), String> + 'a;
+/// Something that draws a chart into a bitmap.
+type DrawBitmap<'a> =
+    dyn for<'b> Fn(&DrawingArea<BitMapBackend<'b>, Shift>) -> Result<(), String> + 'a;
+
+/// Write a chart as `stem.svg` and `stem.png` in `dir`, drawn by `draw`.
+fn write_chart(
+    dir: &Path,
+    stem: &str,
+    draw: &DrawSvg,
+    draw_bitmap: &DrawBitmap,
+) -> Result<Vec<std::path::PathBuf>, Error> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        draw(&root).map_err(|e| chart_error(dir, stem, e))?;
+        root.present()
+            .map_err(|e| chart_error(dir, stem, e.to_string()))?;
+    }
+    let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+        draw_bitmap(&root).map_err(|e| chart_error(dir, stem, e))?;
+        root.present()
+            .map_err(|e| chart_error(dir, stem, e.to_string()))?;
+    }
+    let png = {
+        use image::codecs::png::PngEncoder;
+        use image::ImageEncoder;
+        let mut bytes = Vec::new();
+        PngEncoder::new(&mut bytes)
+            .write_image(&rgb, SIZE.0, SIZE.1, image::ExtendedColorType::Rgb8)
+            .expect("encoding a PNG into memory cannot fail");
+        bytes
+    };
+    let files = vec![
+        (dir.join(format!("{stem}.svg")), svg.into_bytes()),
+        (dir.join(format!("{stem}.png")), png),
+    ];
+    crate::output::write_all_atomically(&files)?;
+    Ok(files.into_iter().map(|(p, _)| p).collect())
+}
+
+fn chart_error(dir: &Path, stem: &str, message: String) -> Error {
+    Error::Output {
+        path: dir.join(stem),
+        message: format!("cannot draw the chart: {message}"),
+    }
+}
+
+/// A range that holds `values` on a log axis, with a margin.
+fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    (lo / 1.6)..(hi * 1.6)
+}
+
+/// Draw the speed-against-accuracy chart on `root`.
+fn draw_sweep<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    points: &[Point],
+    title: &str,
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    let floor = 1e-3;
+    let xs = log_range(points.iter().map(|p| p.median_s * 1e3));
+    let ys = log_range(points.iter().map(|p| p.rmse.max(floor)));
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 20))
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d(xs.log_scale(), ys.log_scale())
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .light_line_style(TRANSPARENT)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.2}"))
+        .x_desc("milliseconds per frame (median, render only)")
+        .y_desc("error: RMSE against the reference (8-bit levels)")
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .draw()
+        .map_err(e)?;
+    let mut frontier: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|p| p.frontier)
+        .map(|p| (p.median_s * 1e3, p.rmse.max(floor)))
+        .collect();
+    frontier.sort_by(|a, b| a.0.total_cmp(&b.0));
+    chart
+        .draw_series(LineSeries::new(frontier, BLUE.stroke_width(2)))
+        .map_err(e)?
+        .label("Pareto frontier")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(2)));
+    let red = RGBColor(200, 30, 30);
+    // Labels: beside their point, moved down a line while they would overlap a
+    // label already placed (settings that give the same picture sit together).
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&a, &b| points[a].rmse.total_cmp(&points[b].rmse).reverse());
+    let mut placed: Vec<(i32, i32, i32)> = Vec::new();
+    let mut elements = Vec::new();
+    for i in order {
+        let p = &points[i];
+        let at = (p.median_s * 1e3, p.rmse.max(floor));
+        let (px, py) = chart.backend_coord(&at);
+        let label = p.label.clone();
+        let width = 7 * label.chars().count() as i32;
+        let mut dy = -14;
+        while placed
+            .iter()
+            .any(|&(x, y, w)| (py + dy - y).abs() < 14 && px < x + w && x < px + width)
+        {
+            dy += 14;
+        }
+        placed.push((px, py + dy, width));
+        let (colour, size) = if p.default { (red, 7) } else { (BLACK, 4) };
+        elements.push(
+            EmptyElement::at(at)
+                + Circle::new((0, 0), size, colour.filled())
+                + Text::new(
+                    label,
+                    (8, dy),
+                    ("sans-serif", 13).into_font().color(&colour),
+                ),
+        );
+    }
+    chart.draw_series(elements).map_err(e)?;
+    chart
+        .configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE)
+        .label_font(("sans-serif", 14))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(e)?;
+    Ok(())
+}
+
+/// Write the speed-against-accuracy chart as `stem.svg` and `stem.png`.
+pub fn write_sweep(
+    dir: &Path,
+    stem: &str,
+    points: &[Point],
+    title: &str,
+) -> Result<Vec<std::path::PathBuf>, Error> {
+    write_chart(
+        dir,
+        stem,
+        &|root| draw_sweep(root, points, title),
+        &|root| draw_sweep(root, points, title),
+    )
+}
+
+/// Draw the time-against-spheres chart on `root`.
+fn draw_scale<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    points: &[ScalePoint],
+    title: &str,
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    let xs = log_range(points.iter().map(|p| p.count as f64));
+    let ys = log_range(points.iter().map(|p| p.median_s * 1e3));
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 20))
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d(xs.log_scale(), ys.log_scale())
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .light_line_style(TRANSPARENT)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .x_desc("spheres in the scene")
+        .y_desc("milliseconds per frame (median)")
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .draw()
+        .map_err(e)?;
+    for (accel, colour, name) in [
+        (Accel::Auto, BLUE, "--accel auto (BVH from 12 spheres)"),
+        (
+            Accel::Off,
+            RGBColor(200, 30, 30),
+            "--accel off (plain loop)",
+        ),
+    ] {
+        let series: Vec<(f64, f64)> = points
+            .iter()
+            .filter(|p| p.accel == accel)
+            .map(|p| (p.count as f64, p.median_s * 1e3))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(series.clone(), colour.stroke_width(2)))
+            .map_err(e)?
+            .label(name)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+        chart
+            .draw_series(
+                series
+                    .into_iter()
+                    .map(|(x, y)| Circle::new((x, y), 4, colour.filled())),
+            )
+            .map_err(e)?;
+    }
+    chart
+        .configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE)
+        .label_font(("sans-serif", 14))
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()
+        .map_err(e)?;
+    Ok(())
+}
+
+/// Write the time-against-spheres chart as `stem.svg` and `stem.png`.
+pub fn write_scale(
+    dir: &Path,
+    stem: &str,
+    points: &[ScalePoint],
+    title: &str,
+) -> Result<Vec<std::path::PathBuf>, Error> {
+    write_chart(
+        dir,
+        stem,
+        &|root| draw_scale(root, points, title),
+        &|root| draw_scale(root, points, title),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(label: &str, ms: f64, rmse: f64) -> Point {
+        Point {
+            label: label.into(),
+            median_s: ms / 1e3,
+            rmse,
+            worst: rmse,
+            default: false,
+            frontier: false,
+        }
+    }
+
+    #[test]
+    fn the_frontier_keeps_the_points_nothing_beats_on_both_axes() {
+        let mut points = vec![
+            point("fast, rough", 1.0, 10.0),
+            point("slow, fine", 10.0, 1.0),
+            point("slow and rough", 10.0, 10.0),
+            point("middle", 5.0, 5.0),
+            point("beaten by middle", 6.0, 6.0),
+        ];
+        mark_frontier(&mut points);
+        let on: Vec<&str> = points
+            .iter()
+            .filter(|p| p.frontier)
+            .map(|p| p.label.as_str())
+            .collect();
+        assert_eq!(on, ["fast, rough", "slow, fine", "middle"]);
+    }
+
+    #[test]
+    fn charts_draw_to_svg_and_png_without_system_fonts() {
+        let dir = tempfile_dir();
+        let mut points = vec![point("a", 1.0, 2.0), point("b", 2.0, 1.0)];
+        points[0].default = true;
+        mark_frontier(&mut points);
+        let files = write_sweep(&dir, "t", &points, "test").unwrap();
+        let svg = std::fs::read_to_string(&files[0]).unwrap();
+        assert!(svg.contains("Pareto frontier") && svg.contains("milliseconds per frame"));
+        // The two labels, each as its own line of text.
+        assert!(svg.lines().any(|l| l.trim() == "a") && svg.lines().any(|l| l.trim() == "b"));
+        let png = image::open(&files[1]).unwrap().to_rgb8();
+        // Some pixels are not white: the axes, the points, the text.
+        assert!(png.pixels().filter(|p| p.0 != [255, 255, 255]).count() > 1000);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    fn tempfile_dir() -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("raystep-chart-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+}

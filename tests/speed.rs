@@ -1,0 +1,317 @@
+//! What the speed work promises: the fast paths change no pixel, the yardstick is
+//! the tutorial's program, rays are counted right, samples and early stop do what
+//! they say, and the pixel loop allocates nothing. (Speed itself is measured by
+//! `raystep bench` and `cargo bench`, never here.)
+
+mod common;
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use raystep::accel::{Accel, EVERY};
+use raystep::aov::Frame;
+use raystep::real::Precision;
+use raystep::render::{render, stratified, Rays, Settings, Tracer};
+use raystep::scene::Scene;
+use raystep::sphere::Method;
+use raystep::stages::Stages;
+use raystep::yardstick::Yardstick;
+
+/// Counts the allocations made by the current thread while `COUNTING` is set.
+struct Counting;
+
+thread_local! {
+    static COUNTING: Cell<bool> = const { Cell::new(false) };
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+// SAFETY: every call is passed on to the system allocator unchanged; the counter
+// only reads and writes thread-local cells, which do not allocate once created.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        if COUNTING.with(Cell::get) {
+            ALLOCATIONS.with(|a| a.set(a.get() + 1));
+        }
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        if COUNTING.with(Cell::get) {
+            ALLOCATIONS.with(|a| a.set(a.get() + 1));
+        }
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+fn load(path: &str, width: u32, height: u32) -> Scene {
+    let mut scene = raystep::scene_file::load(std::path::Path::new(path)).unwrap();
+    (scene.width, scene.height) = (width, height);
+    scene
+}
+
+fn scenes() -> Vec<(String, Scene)> {
+    let mut all = vec![("seed".to_string(), common::seed(160, 90))];
+    for dir in ["scenes", "scenes/stress"] {
+        let mut paths: Vec<_> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .collect();
+        paths.sort();
+        for p in paths {
+            all.push((p.display().to_string(), load(p.to_str().unwrap(), 96, 64)));
+        }
+    }
+    let mut many = raystep::generate::scene(60, 5);
+    (many.width, many.height) = (160, 90);
+    all.push(("60 generated spheres".into(), many));
+    all
+}
+
+#[test]
+fn tile_masks_and_the_bvh_change_no_pixel_of_any_scene() {
+    for (name, scene) in scenes() {
+        for base in [Settings::from(Stages::ALL), Settings::tutorial(Stages::ALL)] {
+            let frames: Vec<Frame> = [Accel::Off, Accel::Auto, Accel::Bvh]
+                .into_iter()
+                .map(|accel| render(&scene, &Settings { accel, ..base }, &|_| {}))
+                .collect();
+            for (frame, accel) in frames[1..].iter().zip(["auto", "bvh"]) {
+                assert!(
+                    frame.pixels == frames[0].pixels && frame.rays == frames[0].rays,
+                    "{name}: --accel {accel} differs from the plain loop ({:?})",
+                    base.method
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_bvh_changes_no_pixel_in_float32_with_the_stable_method_either() {
+    let mut scene = raystep::generate::scene(200, 9);
+    (scene.width, scene.height) = (160, 90);
+    let base = Settings {
+        precision: Precision::F32,
+        method: Method::Stable,
+        ..Settings::from(Stages::ALL)
+    };
+    let off = render(
+        &scene,
+        &Settings {
+            accel: Accel::Off,
+            ..base
+        },
+        &|_| {},
+    );
+    let bvh = render(
+        &scene,
+        &Settings {
+            accel: Accel::Bvh,
+            ..base
+        },
+        &|_| {},
+    );
+    assert!(off.pixels == bvh.pixels);
+}
+
+#[test]
+fn the_yardstick_draws_exactly_the_tutorial_settings_image() {
+    for (w, h) in [(300, 200), (97, 61)] {
+        let scene = common::seed(w, h);
+        let ours = render(&scene, &Settings::tutorial(Stages::ALL), &|_| {});
+        let port = Yardstick::new(&scene)
+            .expect("the seed scene has only spheres")
+            .render();
+        assert_eq!(port.len(), ours.pixels.len());
+        for (i, (a, b)) in port.iter().zip(&ours.pixels).enumerate() {
+            assert_eq!(a.as_vec3().to_array(), b.colour, "pixel {i} at {w} × {h}");
+        }
+    }
+}
+
+#[test]
+fn the_yardstick_refuses_a_true_plane() {
+    assert!(Yardstick::new(&load("scenes/true-plane.toml", 10, 10)).is_none());
+}
+
+#[test]
+fn ray_counts_are_the_tutorials_own() {
+    // TUTORIAL.md: at 300 × 200 the tutorial's program casts 60,000 primary,
+    // 43,331 shadow and 36,140 reflection rays.
+    let frame = render(
+        &common::seed(300, 200),
+        &Settings::tutorial(Stages::ALL),
+        &|_| {},
+    );
+    assert_eq!(
+        frame.rays,
+        Rays {
+            primary: 60_000,
+            shadow: 43_331,
+            reflection: 36_140
+        }
+    );
+    // No shadow rays without the shadow stage; no reflection rays without reflection.
+    let no_shadow = Stages::select(
+        raystep::stages::Stage::Plane,
+        &[raystep::stages::Stage::Shadow],
+    )
+    .unwrap();
+    let frame = render(
+        &common::seed(300, 200),
+        &Settings::tutorial(no_shadow),
+        &|_| {},
+    );
+    assert_eq!(frame.rays.shadow, 0);
+    let up_to_shading = Stages::up_to(raystep::stages::Stage::BlinnPhong);
+    let frame = render(
+        &common::seed(300, 200),
+        &Settings::tutorial(up_to_shading),
+        &|_| {},
+    );
+    assert_eq!(frame.rays.reflection, 0);
+    assert_eq!(frame.rays.primary, 60_000);
+}
+
+#[test]
+fn samples_are_stratified_inside_their_pixel_and_the_same_every_time() {
+    for spp in [4u32, 9, 16] {
+        let n = spp.isqrt();
+        for (row, col) in [(0u32, 0u32), (5, 7), (1079, 1919)] {
+            for s in 0..spp {
+                let (y, x) = stratified(row, col, s, spp);
+                assert_eq!((y, x), stratified(row, col, s, spp));
+                // Inside cell (s / n, s % n) of the pixel's n × n grid.
+                let cell_y = ((y - f64::from(row) + 0.5) * f64::from(n)).floor();
+                let cell_x = ((x - f64::from(col) + 0.5) * f64::from(n)).floor();
+                assert_eq!(
+                    (cell_y as u32, cell_x as u32),
+                    (s / n, s % n),
+                    "spp {spp} sample {s}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn more_samples_smooth_edges_keep_flat_areas_and_keep_the_buffers() {
+    let scene = common::seed(120, 80);
+    let one = render(&scene, &Settings::from(Stages::ALL), &|_| {});
+    let settings = Settings {
+        spp: 16,
+        ..Settings::from(Stages::ALL)
+    };
+    let many = render(&scene, &settings, &|_| {});
+    // The buffers come from the centre ray, whatever the samples.
+    for (a, b) in one.pixels.iter().zip(&many.pixels) {
+        assert_eq!((a.depth, a.normal, a.shadow), (b.depth, b.normal, b.shadow));
+    }
+    // 16 samples and the centre ray per pixel.
+    assert_eq!(many.rays.primary, 17 * 120 * 80);
+    // Sky far from any edge: the same colour (black).
+    assert_eq!(many.at(0, 0).colour, one.at(0, 0).colour);
+    // At least some edge pixels now hold a mix.
+    let changed = one
+        .pixels
+        .iter()
+        .zip(&many.pixels)
+        .filter(|(a, b)| a.colour != b.colour)
+        .count();
+    assert!(changed > 100, "{changed}");
+    // The same on one thread and several.
+    let single = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    assert!(single.install(|| render(&scene, &settings, &|_| {})).pixels == many.pixels);
+}
+
+#[test]
+fn early_stop_moves_no_channel_more_than_one_8_bit_level_and_saves_rays() {
+    // A corridor of two mirrors, floor and ceiling: every ray that is not level
+    // bounces between them until max_depth.
+    let mut scene = common::scene(
+        "[image]\nwidth = 120\nheight = 80\n[camera]\nposition = [0, 0, 1]\n\
+         [light]\nposition = [0, 0, -5]\n\
+         [[plane]]\npoint = [0, -1, 0]\nnormal = [0, 1, 0]\nreflection = 0.7\n\
+         ambient = [0.05, 0, 0]\ndiffuse = [0.2, 0.05, 0.05]\nspecular = [0.3, 0.3, 0.3]\n\
+         [[plane]]\npoint = [0, 1, 0]\nnormal = [0, -1, 0]\nreflection = 0.7\n\
+         ambient = [0, 0, 0.05]\ndiffuse = [0.05, 0.05, 0.2]\nspecular = [0.3, 0.3, 0.3]\n",
+    );
+    scene.max_depth = 48;
+    // Without shadows, so that paths are not cut short at a shadowed point.
+    let stages = Stages::select(raystep::stages::Stage::Plane, &[raystep::stages::Stage::Shadow]).unwrap();
+    let base = Settings::from(stages);
+    let on = render(
+        &scene,
+        &Settings {
+            early_stop: true,
+            ..base
+        },
+        &|_| {},
+    );
+    let off = render(
+        &scene,
+        &Settings {
+            early_stop: false,
+            ..base
+        },
+        &|_| {},
+    );
+    assert!(
+        on.rays.reflection < off.rays.reflection,
+        "{:?} {:?}",
+        on.rays,
+        off.rays
+    );
+    let level = |c: f32| (c * 255.0).round() as i32;
+    for (a, b) in on.pixels.iter().zip(&off.pixels) {
+        for c in 0..3 {
+            assert!((level(a.colour[c]) - level(b.colour[c])).abs() <= 1);
+            // Half a step, before rounding: the bound it is built on.
+            assert!((a.colour[c] - b.colour[c]).abs() <= 0.5 / 255.0 + 1e-7);
+        }
+    }
+}
+
+#[test]
+fn the_pixel_loop_allocates_nothing() {
+    let mut many = raystep::generate::scene(100, 3);
+    (many.width, many.height) = (64, 36);
+    for (scene, settings) in [
+        (common::seed(64, 36), Settings::from(Stages::ALL)),
+        (common::seed(64, 36), Settings::tutorial(Stages::ALL)),
+        (
+            common::seed(64, 36),
+            Settings {
+                spp: 4,
+                ..Settings::from(Stages::ALL)
+            },
+        ),
+        (many, Settings::from(Stages::ALL)),
+    ] {
+        let tracer = Tracer::<f64>::new(&scene, &settings);
+        COUNTING.with(|c| c.set(true));
+        let mut sum = 0.0;
+        for row in 0..scene.height {
+            for col in 0..scene.width {
+                sum += tracer.pixel(row, col).0.colour[0];
+            }
+        }
+        COUNTING.with(|c| c.set(false));
+        assert!(sum > 0.0);
+        assert_eq!(
+            ALLOCATIONS.with(Cell::get),
+            0,
+            "allocations in the pixel loop"
+        );
+        let _ = tracer.trace(scene.camera().primary_ray(0, 0), EVERY);
+    }
+}
