@@ -123,3 +123,52 @@ fn intersect<T: Real>(bencher: Bencher, method: &str) {
                 .count()
         });
 }
+
+/// Building the BVH over N generated spheres (the target: a million in
+/// under a second).
+#[divan::bench(args = [1_000, 100_000, 1_000_000], sample_count = 5)]
+fn bvh_build(bencher: Bencher, count: usize) {
+    let scene = raystep::generate::scene(count, 1);
+    let objects: Vec<raystep::scene::Object> = scene.objects_in_play(Stages::ALL);
+    let extent = raystep::render::extent(&scene);
+    bencher.bench(|| raystep::bvh::Bvh::build(&objects, extent));
+}
+
+/// The nearest hit of 4,096 primary rays among N generated spheres: the plain
+/// loop against the BVH (where they cross is `accel::BVH_FROM`).
+#[divan::bench(args = [4, 8, 12, 16, 32, 1_000])]
+fn nearest_hit_list(bencher: Bencher, count: usize) {
+    let (objects, rays) = spheres_and_rays(count);
+    bencher.bench(|| {
+        rays.iter()
+            .filter(|r| {
+                raystep::scene::nearest_hit(&objects, divan::black_box(r), Method::Stable).is_some()
+            })
+            .count()
+    });
+}
+
+/// See [`nearest_hit_list`].
+#[divan::bench(args = [4, 8, 12, 16, 32, 1_000, 100_000])]
+fn nearest_hit_bvh(bencher: Bencher, count: usize) {
+    let (objects, rays) = spheres_and_rays(count);
+    let bvh = raystep::bvh::Bvh::build(&objects, 100.0);
+    bencher.bench(|| {
+        rays.iter()
+            .filter(|r| {
+                bvh.nearest_hit(&objects, divan::black_box(r), Method::Stable)
+                    .is_some()
+            })
+            .count()
+    });
+}
+
+fn spheres_and_rays(count: usize) -> (Vec<raystep::scene::Object>, Vec<Ray<f64>>) {
+    let mut scene = raystep::generate::scene(count, 1);
+    (scene.width, scene.height) = (64, 64);
+    let camera = scene.camera();
+    let rays = (0..64 * 64)
+        .map(|i| camera.primary_ray::<f64>(i / 64, i % 64))
+        .collect();
+    (scene.objects_in_play(Stages::ALL), rays)
+}

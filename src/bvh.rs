@@ -60,15 +60,22 @@ struct Item {
 }
 
 impl Bvh {
-    /// Build the hierarchy over the `[[sphere]]` objects of `objects`.
-    pub fn build<T: Real>(objects: &[Object<T>]) -> Bvh {
+    /// Build the hierarchy over the `[[sphere]]` objects of `objects`. `extent`
+    /// is the largest coordinate any ray may start from or reach (the camera, the
+    /// light, every object): boxes are widened by 64·u·`extent`, more than the
+    /// rounding of the stable intersection test in precision `T` can move a hit.
+    /// (The textbook quadratic's rounding can report hits far outside a sphere; a
+    /// box would hide them and change the picture, so the tracer uses no BVH with
+    /// `--intersect naive`.)
+    pub fn build<T: Real>(objects: &[Object<T>], extent: f64) -> Bvh {
         let mut items = Vec::with_capacity(objects.len());
         let mut loose = Vec::new();
+        let pad = 64.0 * T::UNIT_ROUNDOFF.to_f64() * extent;
         for (i, o) in objects.iter().enumerate() {
             match o.shape {
                 Shape::Sphere(s) if o.role == Role::Sphere => {
                     let (c, r) = (s.center.to_f64(), s.radius.to_f64());
-                    let half = Vec3::splat(r + 1e-9 * (r + c.abs().max_element()));
+                    let half = Vec3::splat(r + pad + 1e-9 * (r + c.abs().max_element()));
                     items.push(Item {
                         index: i as u32,
                         min: c - half,
@@ -142,13 +149,15 @@ impl Bvh {
             + (self.items.capacity() + self.loose.capacity()) * 4
     }
 
+    // ANCHOR: enter
     /// Where `ray` enters the box of `node`, if it does before `limit`.
     #[inline]
     fn enter(node: &Node, origin: Vec3, inverse: Vec3, limit: f64) -> Option<f64> {
         let t1 = (node.min - origin) * inverse;
         let t2 = (node.max - origin) * inverse;
-        // `f64::min` and `max` skip a NaN (0 · ∞, a ray in a box's face plane),
-        // which then counts as inside along that axis: a box is never missed wrongly.
+        // A direction component of 0 makes that axis's slab ±∞ (the ray is inside
+        // the slab for ever, or never); `f64::min` and `max` skip the NaN of
+        // 0 · ∞, a ray exactly in a face plane.
         let near =
             t1.x.min(t2.x)
                 .max(t1.y.min(t2.y))
@@ -157,6 +166,7 @@ impl Bvh {
         let far = t1.x.max(t2.x).min(t1.y.max(t2.y)).min(t1.z.max(t2.z));
         (near <= far && near <= limit).then_some(near)
     }
+    // ANCHOR_END: enter
 
     /// The nearest object along `ray`, as [`crate::scene::nearest_hit`] finds it.
     pub fn nearest_hit<T: Real>(
@@ -188,6 +198,7 @@ impl Bvh {
                     consider(objects, ray, method, self.items[k as usize], &mut nearest);
                 }
             } else {
+                // ANCHOR: descend
                 let bound = limit(&nearest);
                 let (a, b) = (node + 1, n.first as usize);
                 let ta = Self::enter(&self.nodes[a], origin, inverse, bound);
@@ -210,6 +221,7 @@ impl Bvh {
                     }
                     (None, None) => {}
                 }
+                // ANCHOR_END: descend
             }
             // Next from the stack, skipping boxes now beyond the nearest hit.
             loop {
@@ -337,7 +349,7 @@ mod tests {
                 )
             })
             .collect();
-        let bvh = Bvh::build(&objects);
+        let bvh = Bvh::build(&objects, 100.0);
         let mut seen = bvh.items.clone();
         seen.sort_unstable();
         assert_eq!(seen, (0..1000).collect::<Vec<u32>>());
@@ -358,7 +370,7 @@ mod tests {
         let objects: Vec<Object> = (0..100)
             .map(|i| ball(0.0, 0.0, -f64::from(i) - 2.0, 0.4))
             .collect();
-        let bvh = Bvh::build(&objects);
+        let bvh = Bvh::build(&objects, 100.0);
         let ray = Ray::towards(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0));
         let hit = bvh.nearest_hit(&objects, &ray, Method::Stable).unwrap();
         assert_eq!(hit.object, 0);

@@ -468,6 +468,11 @@ fn bench(mut args: BenchArgs) -> Result<(), Error> {
 fn chart(mut args: ChartArgs) -> Result<(), Error> {
     ensure_folder(&args.out)?;
     let runs = args.runs as usize;
+    if args.scale && args.scene.scene.is_some() {
+        return Err(Error::Usage(
+            "--scale charts generated scenes of N spheres; it takes no scene file".into(),
+        ));
+    }
     if args.scale {
         let size = (
             args.scene.width.unwrap_or(1920),

@@ -39,8 +39,9 @@ pub struct Settings {
     pub accel: Accel,
     /// Samples per pixel, a square number (`--spp`; default and tutorial: 1).
     pub spp: u32,
-    /// End a reflection path once what is left of it cannot change the 8-bit
-    /// pixel (`--early-stop`; default on, tutorial off).
+    /// End a reflection path once what is left of it cannot move a channel by half
+    /// an 8-bit step, so a pixel by at most one level (`--early-stop`; default on,
+    /// tutorial off).
     pub early_stop: bool,
 }
 
@@ -154,17 +155,27 @@ impl<T: Real> Tracer<T> {
         let camera = scene.camera();
         let objects: Vec<Object<T>> = scene.objects_in_play(settings.stages);
         let spheres = objects.iter().filter(|o| o.role == Role::Sphere).count();
-        let bvh = match settings.accel {
-            Accel::Off => None,
-            Accel::Auto => (spheres >= BVH_FROM).then(|| Bvh::build(&objects)),
-            Accel::Bvh => Some(Bvh::build(&objects)),
+        assert!(
+            crate::scene_file::check_spp(settings.spp).is_ok(),
+            "spp {} is not a square from 1 to {}",
+            settings.spp,
+            crate::scene_file::MAX_SPP
+        );
+        // The textbook quadratic reports false hits far outside spheres (chapter
+        // 9); boxes would hide them and change the picture, so it gets no BVH.
+        let tree = match settings.accel {
+            _ if settings.method == Method::Naive => false,
+            Accel::Off => false,
+            Accel::Auto => spheres >= BVH_FROM,
+            Accel::Bvh => true,
         };
+        let bvh = tree.then(|| Bvh::build(&objects, extent(scene)));
         let masks = match settings.accel {
             Accel::Off => TileMasks::none(),
             Accel::Auto | Accel::Bvh => TileMasks::new(&camera, &objects),
         };
         let reach = if settings.early_stop {
-            reach(&objects, &scene.light, scene.max_depth)
+            reach(&objects, &scene.light, scene.max_depth, settings.stages)
         } else {
             Vec::new()
         };
@@ -250,6 +261,7 @@ impl<T: Real> Tracer<T> {
         if self.spp == 1 {
             return (PixelRecord::new(traced.colour, traced.first), traced.rays);
         }
+        // ANCHOR: samples
         // Several samples: the colour is their mean; the buffers keep the centre
         // ray's first hit, so they read the same whatever the sample count.
         let mut rays = traced.rays;
@@ -263,6 +275,7 @@ impl<T: Real> Tracer<T> {
         }
         let colour = sum / f64::from(self.spp);
         (PixelRecord::new(colour, traced.first), rays)
+        // ANCHOR_END: samples
     }
     // ANCHOR_END: pixel
 
@@ -337,6 +350,7 @@ impl<T: Real> Tracer<T> {
             colour += illumination * weight;
             weight = weight * object.material.reflection;
             ray = reflection::reflected_ray(shifted, &ray, normal);
+            // ANCHOR: early_stop
             // Early stop: nothing the rest of the path adds can change the pixel.
             let left = (segments - segment - 1) as usize;
             if self
@@ -346,6 +360,7 @@ impl<T: Real> Tracer<T> {
             {
                 break;
             }
+            // ANCHOR_END: early_stop
         }
         // The pixel's colour: the sum, clipped to what a screen can show.
         Traced {
@@ -358,19 +373,41 @@ impl<T: Real> Tracer<T> {
     // ANCHOR_END: trace
 }
 
+/// The largest coordinate a ray of `scene` can start from or reach: the camera,
+/// the light, and every object's size ([`Object::magnitude`]).
+pub fn extent(scene: &Scene) -> f64 {
+    let objects: Vec<Object> = scene.objects_in_play(Stages::ALL);
+    objects
+        .iter()
+        .map(Object::magnitude)
+        .fold(scene.camera.abs().max_element(), f64::max)
+        .max(scene.light.position.abs().max_element())
+}
+
+// ANCHOR: reach
 /// The most that `k` more segments can add to a channel, for `k` from 0 to
 /// `max_depth`, when each segment's weight is 1: segment `i` adds at most
 /// `ρⁱ · B`, with `B` the largest `|ka·la| + |kd·ld| + |ks·ls|` of any object and
 /// channel (every Blinn-Phong factor is at most 1 in size) and `ρ` the largest
 /// reflection.
-fn reach<T: Real>(objects: &[Object<T>], light: &Light, max_depth: u32) -> Vec<f64> {
+fn reach<T: Real>(
+    objects: &[Object<T>],
+    light: &Light,
+    max_depth: u32,
+    stages: Stages,
+) -> Vec<f64> {
     let mut most = 0.0f64;
     let mut mirror = 0.0f64;
     for o in objects {
         let m = o.exact().material;
-        let term = (m.ambient * light.ambient).abs()
-            + (m.diffuse * light.diffuse).abs()
-            + (m.specular * light.specular).abs();
+        // Without Blinn-Phong a segment adds its flat diffuse colour.
+        let term = if stages.blinn_phong {
+            (m.ambient * light.ambient).abs()
+                + (m.diffuse * light.diffuse).abs()
+                + (m.specular * light.specular).abs()
+        } else {
+            m.diffuse.abs()
+        };
         most = most.max(term.max_element());
         mirror = mirror.max(m.reflection.abs());
     }
@@ -380,7 +417,9 @@ fn reach<T: Real>(objects: &[Object<T>], light: &Light, max_depth: u32) -> Vec<f
     }
     reach
 }
+// ANCHOR_END: reach
 
+// ANCHOR: stratified
 /// Sample `sample` of `spp` (a square, n × n) in pixel (`row`, `col`): the centre
 /// of one cell of an n × n grid over the pixel, moved by a jitter within the cell.
 /// The jitter comes from a hash of the pixel and the sample, so every render gives
@@ -397,6 +436,7 @@ pub fn stratified(row: u32, col: u32, sample: u32, spp: u32) -> (f64, f64) {
         f64::from(col) - 0.5 + (f64::from(sx) + jx) / n,
     )
 }
+// ANCHOR_END: stratified
 
 /// SplitMix64 (Steele, Lea and Flood, 2014): a 64-bit hash whose outputs pass
 /// the usual statistical tests; one step of it turns a pixel's coordinates into

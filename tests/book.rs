@@ -52,12 +52,12 @@ fn includes(text: &str) -> Vec<(String, Option<String>)> {
 }
 
 #[test]
-fn every_chapter_file_is_in_the_summary_and_there_are_nine_chapters() {
+fn every_chapter_file_is_in_the_summary_and_there_are_ten_chapters() {
     let listed: Vec<String> = chapters().into_iter().map(|(n, _)| n).collect();
     assert_eq!(
         listed.len(),
-        10,
-        "the introduction and nine chapters: {listed:?}"
+        11,
+        "the introduction and ten chapters: {listed:?}"
     );
     for entry in std::fs::read_dir(root().join("chapters")).unwrap() {
         let name = entry.unwrap().file_name().to_string_lossy().into_owned();
@@ -386,4 +386,39 @@ fn the_book_builds_paths_from_its_own_folder() {
     assert!(toml.contains("src = \"../chapters\""));
     assert!(toml.contains("build-dir = \"../target/book\""));
     assert!(Path::new(&root().join("chapters/img")).is_dir());
+}
+
+#[test]
+fn the_charts_shown_exist_and_their_numbers_are_the_csv_files() {
+    let text = chapter("10");
+    for chart in ["charts/chart.svg", "charts/scale.svg"] {
+        assert!(
+            text.contains(&format!("]({chart})")),
+            "chapter 10 shows {chart}"
+        );
+        assert!(
+            root().join("chapters").join(chart).is_file(),
+            "{chart} exists"
+        );
+    }
+    for command in [
+        "raystep chart --out chapters/charts",
+        "raystep chart --scale --runs 3 --out chapters/charts",
+    ] {
+        assert!(text.contains(command), "chapter 10 shows `{command}`");
+    }
+    // The errors the chapter quotes are the chart's.
+    let csv = std::fs::read_to_string(root().join("chapters/charts/chart.csv")).unwrap();
+    let rmse = |setting: &str| -> f64 {
+        let row = csv
+            .lines()
+            .find(|l| l.starts_with(&format!("{setting},")))
+            .unwrap();
+        row.split(',').nth(2).unwrap().parse().unwrap()
+    };
+    assert!((rmse("default") - 2.1).abs() < 0.05 && (rmse("depth 1") - 18.0).abs() < 0.1);
+    assert!(rmse("f32") > 2.0 * rmse("default") - 0.1);
+    assert_eq!(rmse("naive"), rmse("default"));
+    assert_eq!(rmse("accel off"), rmse("default"));
+    assert_eq!(rmse("early stop off"), rmse("default"));
 }

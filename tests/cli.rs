@@ -359,3 +359,97 @@ fn size_flags_override_a_size_the_file_gets_wrong() {
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("image.width = 20000"));
 }
+
+#[test]
+fn bench_prints_one_json_object_with_the_promised_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = raystep(
+        dir.path(),
+        &[
+            "bench", "--width", "64", "--height", "36", "--runs", "1", "--json",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in [
+        "median_s",
+        "rays",
+        "width",
+        "height",
+        "threads",
+        "yardstick_ratio",
+        "rays_shadow",
+    ] {
+        assert!(!json[key].is_null(), "{key} in {json}");
+    }
+    assert_eq!(
+        (json["width"].as_u64(), json["height"].as_u64()),
+        (Some(64), Some(36))
+    );
+    assert_eq!(json["rays_primary"].as_u64(), Some(64 * 36));
+}
+
+#[test]
+fn generate_writes_a_scene_that_loads_and_refuses_a_count_of_zero() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = raystep(
+        dir.path(),
+        &["generate", "spheres", "--count", "25", "--seed", "4"],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let scene = raystep::scene_file::parse(&text(&out.stdout), "generated").unwrap();
+    assert_eq!(scene.objects.len(), 26, "25 spheres and the floor");
+    let again = raystep(
+        dir.path(),
+        &["generate", "spheres", "--count", "25", "--seed", "4"],
+    );
+    assert_eq!(out.stdout, again.stdout, "the same seed, the same bytes");
+    let zero = raystep(dir.path(), &["generate", "spheres", "--count", "0"]);
+    assert_eq!(zero.status.code(), Some(2));
+}
+
+#[test]
+fn spp_must_be_a_square_and_chart_scale_takes_no_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = raystep(
+        dir.path(),
+        &["render", "--spp", "5", "--width", "8", "--height", "8"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("square number"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = raystep(dir.path(), &["render", "--spp", "2000"]);
+    assert!(
+        text(&out.stderr).contains("from 1 to 1024"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = raystep(dir.path(), &["chart", "--scale", "scene.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("takes no scene file"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+#[test]
+fn chart_writes_its_csv_svg_and_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = raystep(
+        dir.path(),
+        &[
+            "chart", "--width", "32", "--height", "18", "--runs", "1", "--out", "c",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let csv = std::fs::read_to_string(dir.path().join("c/chart.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 15, "a header and 14 settings: {csv}");
+    assert_eq!(png_size(&dir.path().join("c/chart.png")), (960, 640));
+    assert!(std::fs::read_to_string(dir.path().join("c/chart.svg"))
+        .unwrap()
+        .starts_with("<svg"));
+}
