@@ -114,16 +114,14 @@ impl TileMasks {
                     camera.screen_point_at::<f64>(r1, c0) - origin,
                 ];
                 let inside = corners.iter().fold(Vec3::ZERO, |a, &c| a + c);
-                let planes: Vec<Vec3> = (0..4)
-                    .map(|i| {
-                        let n = corners[i].cross(corners[(i + 1) % 4]).normalize();
-                        if n.dot(inside) < 0.0 {
-                            -n
-                        } else {
-                            n
-                        }
-                    })
-                    .collect();
+                let planes: [Vec3; 4] = std::array::from_fn(|i| {
+                    let n = corners[i].cross(corners[(i + 1) % 4]).normalize();
+                    if n.dot(inside) < 0.0 {
+                        -n
+                    } else {
+                        n
+                    }
+                });
                 // ANCHOR: tile_test
                 let mut mask = 0u64;
                 for (i, sphere) in spheres.iter().enumerate() {

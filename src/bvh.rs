@@ -21,7 +21,7 @@
 
 use crate::ray::Ray;
 use crate::real::{Real, Vector};
-use crate::scene::{Hit, Object, Role, Shape};
+use crate::scene::{consider, Hit, Object, Role, Shape};
 use crate::sphere::Method;
 use crate::Vec3;
 
@@ -177,7 +177,7 @@ impl Bvh {
     ) -> Option<Hit<T>> {
         let mut nearest: Option<Hit<T>> = None;
         for &i in &self.loose {
-            consider(objects, ray, method, i, &mut nearest);
+            consider(objects, ray, method, i as usize, &mut nearest);
         }
         if self.nodes.is_empty() {
             return nearest;
@@ -195,7 +195,13 @@ impl Bvh {
             let n = self.nodes[node];
             if n.count > 0 {
                 for k in n.first..n.first + n.count {
-                    consider(objects, ray, method, self.items[k as usize], &mut nearest);
+                    consider(
+                        objects,
+                        ray,
+                        method,
+                        self.items[k as usize] as usize,
+                        &mut nearest,
+                    );
                 }
             } else {
                 // ANCHOR: descend
@@ -292,24 +298,6 @@ impl Bvh {
             }
             depth -= 1;
             node = stack[depth] as usize;
-        }
-    }
-}
-
-/// Test object `index` and keep it in `nearest` if it is nearer (or as near, with
-/// a lower index: the plain loop's order).
-#[inline]
-fn consider<T: Real>(
-    objects: &[Object<T>],
-    ray: &Ray<T>,
-    method: Method,
-    index: u32,
-    nearest: &mut Option<Hit<T>>,
-) {
-    if let Some(t) = objects[index as usize].intersect(ray, method) {
-        let index = index as usize;
-        if nearest.is_none_or(|n| t < n.t || (t == n.t && index < n.object)) {
-            *nearest = Some(Hit { t, object: index });
         }
     }
 }

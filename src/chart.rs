@@ -385,17 +385,20 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     (lo / 1.6)..(hi * 1.6)
 }
 
-/// Draw the speed-against-accuracy chart on `root`.
-fn draw_sweep<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    points: &[Point],
+/// A chart whose axes are both logarithmic.
+type LogLog<'a, DB> = ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
+/// The axes of a chart on a white `root`: both logarithmic, over the ranges given,
+/// named, with `y_decimals` decimals on the y labels.
+fn log_log<'a, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
     title: &str,
-) -> Result<(), String> {
+    (xs, x_desc): (std::ops::Range<f64>, &str),
+    (ys, y_desc): (std::ops::Range<f64>, &str),
+    y_decimals: usize,
+) -> Result<LogLog<'a, DB>, String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     root.fill(&WHITE).map_err(e)?;
-    let floor = 1e-3;
-    let xs = log_range(points.iter().map(|p| p.median_s * 1e3));
-    let ys = log_range(points.iter().map(|p| p.rmse.max(floor)));
     let mut chart = ChartBuilder::on(root)
         .caption(title, ("sans-serif", 20))
         .margin(20)
@@ -407,13 +410,52 @@ fn draw_sweep<DB: DrawingBackend>(
         .configure_mesh()
         .light_line_style(TRANSPARENT)
         .x_label_formatter(&|v| format!("{v:.0}"))
-        .y_label_formatter(&|v| format!("{v:.2}"))
-        .x_desc("milliseconds per frame (median, render only)")
-        .y_desc("error: RMSE against the reference (8-bit levels)")
+        .y_label_formatter(&|v| format!("{v:.y_decimals$}"))
+        .x_desc(x_desc)
+        .y_desc(y_desc)
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 15))
         .draw()
         .map_err(e)?;
+    Ok(chart)
+}
+
+/// Draw the legend of the series labelled on `chart`, at `position`.
+fn legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut LogLog<'a, DB>,
+    position: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE)
+        .label_font(("sans-serif", 14))
+        .position(position)
+        .draw()
+        .map_err(|e| e.to_string())
+}
+
+/// Draw the speed-against-accuracy chart on `root`.
+fn draw_sweep<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    points: &[Point],
+    title: &str,
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let floor = 1e-3;
+    let mut chart = log_log(
+        root,
+        title,
+        (
+            log_range(points.iter().map(|p| p.median_s * 1e3)),
+            "milliseconds per frame (median, render only)",
+        ),
+        (
+            log_range(points.iter().map(|p| p.rmse.max(floor))),
+            "error: RMSE against the reference (8-bit levels)",
+        ),
+        2,
+    )?;
     let mut frontier: Vec<(f64, f64)> = points
         .iter()
         .filter(|p| p.frontier)
@@ -458,15 +500,7 @@ fn draw_sweep<DB: DrawingBackend>(
         );
     }
     chart.draw_series(elements).map_err(e)?;
-    chart
-        .configure_series_labels()
-        .border_style(BLACK)
-        .background_style(WHITE)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(e)?;
-    Ok(())
+    legend(&mut chart, SeriesLabelPosition::UpperRight)
 }
 
 /// Write the speed-against-accuracy chart as `stem.svg` and `stem.png`.
@@ -491,27 +525,19 @@ fn draw_scale<DB: DrawingBackend>(
     title: &str,
 ) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-    root.fill(&WHITE).map_err(e)?;
-    let xs = log_range(points.iter().map(|p| p.count as f64));
-    let ys = log_range(points.iter().map(|p| p.median_s * 1e3));
-    let mut chart = ChartBuilder::on(root)
-        .caption(title, ("sans-serif", 20))
-        .margin(20)
-        .x_label_area_size(50)
-        .y_label_area_size(70)
-        .build_cartesian_2d(xs.log_scale(), ys.log_scale())
-        .map_err(e)?;
-    chart
-        .configure_mesh()
-        .light_line_style(TRANSPARENT)
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .y_label_formatter(&|v| format!("{v:.0}"))
-        .x_desc("spheres in the scene")
-        .y_desc("milliseconds per frame (median)")
-        .label_style(("sans-serif", 14))
-        .axis_desc_style(("sans-serif", 15))
-        .draw()
-        .map_err(e)?;
+    let mut chart = log_log(
+        root,
+        title,
+        (
+            log_range(points.iter().map(|p| p.count as f64)),
+            "spheres in the scene",
+        ),
+        (
+            log_range(points.iter().map(|p| p.median_s * 1e3)),
+            "milliseconds per frame (median)",
+        ),
+        0,
+    )?;
     for (accel, colour, name) in [
         (Accel::Auto, BLUE, "--accel auto (BVH from 12 spheres)"),
         (
@@ -540,15 +566,7 @@ fn draw_scale<DB: DrawingBackend>(
             )
             .map_err(e)?;
     }
-    chart
-        .configure_series_labels()
-        .border_style(BLACK)
-        .background_style(WHITE)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()
-        .map_err(e)?;
-    Ok(())
+    legend(&mut chart, SeriesLabelPosition::UpperLeft)
 }
 
 /// Write the time-against-spheres chart as `stem.svg` and `stem.png`.

@@ -117,16 +117,7 @@ pub enum Generated {
 pub struct BenchArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub scene: SceneArgs,
-    /// Turn on every stage up to and including this one.
-    #[arg(long, value_enum, default_value = "plane")]
-    pub stage: Stage,
-    /// Turn one stage off again (repeatable).
-    #[arg(long, value_enum)]
-    pub without: Vec<Stage>,
-    #[command(flatten)]
-    #[allow(missing_docs)]
-    pub rules: RuleArgs,
+    pub frame: FrameArgs,
     /// Threads to render with [default: one per core].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
@@ -231,9 +222,9 @@ pub struct StagesArgs {
     pub out: PathBuf,
 }
 
-/// Arguments of `raystep render`.
+/// One frame to render: the scene, the stages and the rules (`render`, `bench`).
 #[derive(Args, Debug)]
-pub struct RenderArgs {
+pub struct FrameArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
     pub scene: SceneArgs,
@@ -246,6 +237,14 @@ pub struct RenderArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
     pub rules: RuleArgs,
+}
+
+/// Arguments of `raystep render`.
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub frame: FrameArgs,
     /// Output folder.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
@@ -341,12 +340,22 @@ impl RuleArgs {
     }
 }
 
-/// The scene and settings a `render` command line asks for.
-pub fn prepare(args: &RenderArgs) -> Result<(Scene, Settings), Error> {
+/// The scene and settings a `render` (or `bench`) command line asks for.
+pub fn prepare(args: &FrameArgs) -> Result<(Scene, Settings), Error> {
     let stages = Stages::select(args.stage, &args.without).map_err(Error::Usage)?;
     let (mut scene, _) = load_scene(&args.scene)?;
     let settings = args.rules.apply(&mut scene, stages)?;
     Ok((scene, settings))
+}
+
+impl SceneArgs {
+    /// Render the built-in scene at `width × height` unless a scene or a size was
+    /// given.
+    fn default_size(&mut self, width: u32, height: u32) {
+        if self.scene.is_none() && self.width.is_none() && self.height.is_none() {
+            (self.width, self.height) = (Some(width), Some(height));
+        }
+    }
 }
 
 fn scene_name(args: &SceneArgs) -> String {
@@ -397,9 +406,9 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
 }
 
 fn render_one(args: RenderArgs) -> Result<(), Error> {
-    let (scene, settings) = prepare(&args)?;
+    let (scene, settings) = prepare(&args.frame)?;
     ensure_folder(&args.out)?;
-    let name = scene_name(&args.scene);
+    let name = scene_name(&args.frame.scene);
     say!(
         "{name}: {} at {} × {}",
         settings.stages,
@@ -431,12 +440,9 @@ fn write(frame: &Frame, dir: &Path, render_seconds: f64, bar: &ProgressBar) -> R
 }
 
 fn bench(mut args: BenchArgs) -> Result<(), Error> {
-    if args.scene.scene.is_none() && args.scene.width.is_none() && args.scene.height.is_none() {
-        (args.scene.width, args.scene.height) = (Some(1920), Some(1080));
-    }
-    let stages = Stages::select(args.stage, &args.without).map_err(Error::Usage)?;
-    let (mut scene, name) = load_scene(&args.scene)?;
-    let settings = args.rules.apply(&mut scene, stages)?;
+    args.frame.scene.default_size(1920, 1080);
+    let (scene, settings) = prepare(&args.frame)?;
+    let name = scene_name(&args.frame.scene);
     let threads = args
         .threads
         .map_or_else(rayon::current_num_threads, |t| t as usize);
@@ -448,12 +454,7 @@ fn bench(mut args: BenchArgs) -> Result<(), Error> {
     if !args.json {
         say!("{name}: {}", settings.stages);
     }
-    let bar = progress_bar(u64::from(args.runs) + 1);
-    bar.set_style(
-        ProgressStyle::with_template("bench [{bar:30}] {pos}/{len} runs, {eta} left")
-            .expect("the template is valid")
-            .progress_chars("=> "),
-    );
+    let bar = counted_bar(u64::from(args.runs) + 1, "bench", "runs");
     let report = crate::bench::bench(&scene, &settings, options, &|n| bar.inc(n))?;
     bar.finish_and_clear();
     if args.json {
@@ -495,12 +496,7 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
             size.1,
             counts.len()
         );
-        let bar = progress_bar(renders);
-        bar.set_style(
-            ProgressStyle::with_template("scale [{bar:30}] {pos}/{len} renders, {eta} left")
-                .expect("the template is valid")
-                .progress_chars("=> "),
-        );
+        let bar = counted_bar(renders, "scale", "renders");
         let points = crate::chart::scale(&counts, plain_up_to, size, runs, &|n| bar.inc(n));
         bar.finish_and_clear();
         let csv = crate::chart::scale_csv(&points);
@@ -511,21 +507,14 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
         say!("wrote {}/scale.csv, {}", args.out.display(), names(&files));
         return Ok(());
     }
-    if args.scene.scene.is_none() && args.scene.width.is_none() && args.scene.height.is_none() {
-        (args.scene.width, args.scene.height) = (Some(960), Some(540));
-    }
+    args.scene.default_size(960, 540);
     let (scene, name) = load_scene(&args.scene)?;
     say!(
         "{name}: speed against accuracy at {} × {}",
         scene.width,
         scene.height
     );
-    let bar = progress_bar(crate::chart::sweep_renders(runs));
-    bar.set_style(
-        ProgressStyle::with_template("chart [{bar:30}] {pos}/{len} renders, {eta} left")
-            .expect("the template is valid")
-            .progress_chars("=> "),
-    );
+    let bar = counted_bar(crate::chart::sweep_renders(runs), "chart", "renders");
     let points = crate::chart::sweep(&scene, runs, &|n| bar.inc(n));
     bar.finish_and_clear();
     let csv = crate::chart::csv(&points);
@@ -554,11 +543,18 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
     (value, start.elapsed().as_secs_f64())
 }
 
-/// A bar on stderr, drawn only when stderr is a terminal.
+/// A bar of rows on stderr, drawn only when stderr is a terminal.
 fn progress_bar(rows: u64) -> ProgressBar {
-    let bar = ProgressBar::with_draw_target(Some(rows), ProgressDrawTarget::stderr());
+    counted_bar(rows, "{msg:>16}", "rows")
+}
+
+/// A bar on stderr counting `len` `unit`s after `label`, drawn only when stderr is
+/// a terminal.
+fn counted_bar(len: u64, label: &str, unit: &str) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    let template = format!("{label} [{{bar:30}}] {{pos}}/{{len}} {unit}, {{eta}} left");
     bar.set_style(
-        ProgressStyle::with_template("{msg:>16} [{bar:30}] {pos}/{len} rows, {eta} left")
+        ProgressStyle::with_template(&template)
             .expect("the template is valid")
             .progress_chars("=> "),
     );

@@ -97,8 +97,8 @@ pub fn render_command(args: &str, root: &Path) -> Result<Frame, Error> {
             "`raystep {args}` is not a render command"
         )));
     };
-    render.scene.scene = render.scene.scene.map(|p| root.join(p));
-    let (scene, settings) = crate::cli::prepare(&render)?;
+    render.frame.scene.scene = render.frame.scene.scene.map(|p| root.join(p));
+    let (scene, settings) = crate::cli::prepare(&render.frame)?;
     Ok(crate::render::render(&scene, &settings, &|_| {}))
 }
 

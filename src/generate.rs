@@ -10,7 +10,7 @@
 
 use std::fmt::Write;
 
-use crate::render::splitmix64;
+use crate::render::{splitmix64, unit_interval};
 use crate::scene::{Material, Object, Role, Scene, Shape};
 use crate::sphere::Sphere;
 use crate::Vec3;
@@ -38,7 +38,7 @@ pub fn spheres(count: usize, seed: u64) -> Vec<Ball> {
     let mut state = splitmix64(seed);
     let mut next = move || {
         state = splitmix64(state);
-        (state >> 11) as f64 / (1u64 << 53) as f64
+        unit_interval(state)
     };
     let round = |x: f64| (x * 1e5).round() / 1e5;
     let (width, depth) = (10.0, 12.0);

@@ -60,9 +60,7 @@ pub fn write_frame(frame: &Frame, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         || write_exr(frame, &temporaries[buffers.len()], &paths[buffers.len()]),
     );
     if let Err(e) = pngs.and(exr) {
-        for t in &temporaries {
-            let _ = fs::remove_file(t);
-        }
+        remove_all(&temporaries);
         return Err(e);
     }
     rename_all(&temporaries, &paths)?;
@@ -81,15 +79,21 @@ pub fn write_frame(frame: &Frame, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     Ok(paths)
 }
 
+/// Remove the temporary files of a write that failed (those already renamed, or
+/// never made, are simply not there).
+fn remove_all(temporaries: &[PathBuf]) {
+    for t in temporaries {
+        let _ = fs::remove_file(t);
+    }
+}
+
 /// Rename each complete temporary file onto its path. A failure removes the
 /// temporary files left (a failure among the renames, which do not fail on a
 /// working disk, may leave some files renamed).
 fn rename_all(temporaries: &[PathBuf], paths: &[PathBuf]) -> Result<(), Error> {
     for (temporary, path) in temporaries.iter().zip(paths) {
         if let Err(e) = fs::rename(temporary, path) {
-            for t in temporaries {
-                let _ = fs::remove_file(t);
-            }
+            remove_all(temporaries);
             return Err(Error::Output {
                 path: path.clone(),
                 message: e.to_string(),
@@ -107,9 +111,7 @@ pub fn write_all_atomically(files: &[(PathBuf, Vec<u8>)]) -> Result<(), Error> {
     let temporaries: Vec<PathBuf> = paths.iter().map(|p| temporary_name(p)).collect();
     for ((path, bytes), temporary) in files.iter().zip(&temporaries) {
         if let Err(e) = fs::write(temporary, bytes) {
-            for t in &temporaries {
-                let _ = fs::remove_file(t);
-            }
+            remove_all(&temporaries);
             return Err(Error::Output {
                 path: path.clone(),
                 message: e.to_string(),

@@ -11,7 +11,7 @@ use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::ray::Ray;
 use crate::real::{Precision, Real, Vector};
-use crate::scene::{nearest_hit, Hit, Light, Object, Role, Scene};
+use crate::scene::{consider, nearest_hit, Hit, Light, Object, Role, Scene};
 use crate::shade::blinn_phong::{self, Viewer};
 use crate::shade::reflection;
 use crate::shade::shadow::{self, Offset};
@@ -211,11 +211,7 @@ impl<T: Real> Tracer<T> {
         while left != 0 {
             let index = left.trailing_zeros() as usize;
             left &= left - 1;
-            if let Some(t) = self.objects[index].intersect(ray, self.method) {
-                if nearest.is_none_or(|n| t < n.t) {
-                    nearest = Some(Hit { t, object: index });
-                }
-            }
+            consider(&self.objects, ray, self.method, index, &mut nearest);
         }
         nearest
     }
@@ -376,8 +372,8 @@ impl<T: Real> Tracer<T> {
 /// The largest coordinate a ray of `scene` can start from or reach: the camera,
 /// the light, and every object's size ([`Object::magnitude`]).
 pub fn extent(scene: &Scene) -> f64 {
-    let objects: Vec<Object> = scene.objects_in_play(Stages::ALL);
-    objects
+    scene
+        .objects
         .iter()
         .map(Object::magnitude)
         .fold(scene.camera.abs().max_element(), f64::max)
@@ -428,8 +424,7 @@ pub fn stratified(row: u32, col: u32, sample: u32, spp: u32) -> (f64, f64) {
     let n = spp.isqrt();
     let (sy, sx) = (sample / n, sample % n);
     let bits = splitmix64(u64::from(row) << 40 ^ u64::from(col) << 20 ^ u64::from(sample));
-    let unit = |b: u64| (b >> 11) as f64 / (1u64 << 53) as f64;
-    let (jy, jx) = (unit(bits), unit(splitmix64(bits)));
+    let (jy, jx) = (unit_interval(bits), unit_interval(splitmix64(bits)));
     let n = f64::from(n);
     (
         f64::from(row) - 0.5 + (f64::from(sy) + jy) / n,
@@ -437,6 +432,12 @@ pub fn stratified(row: u32, col: u32, sample: u32, spp: u32) -> (f64, f64) {
     )
 }
 // ANCHOR_END: stratified
+
+/// A number in [0, 1) from the top 53 bits of `bits`: every float64 of the form
+/// k / 2⁵³, equally likely.
+pub fn unit_interval(bits: u64) -> f64 {
+    (bits >> 11) as f64 / (1u64 << 53) as f64
+}
 
 /// SplitMix64 (Steele, Lea and Flood, 2014): a 64-bit hash whose outputs pass
 /// the usual statistical tests; one step of it turns a pixel's coordinates into

@@ -179,6 +179,25 @@ pub fn blocked<T: Real>(objects: &[Object<T>], ray: &Ray<T>, distance: T, method
 }
 // ANCHOR_END: nearest_hit
 
+/// One step of a search for the nearest hit that visits the objects in another
+/// order than [`nearest_hit`] (the BVH) or skips some (the tile masks): test object
+/// `index` and keep it in `nearest` if it is nearer, or as near with a lower index,
+/// so that the result is the plain loop's whatever the order.
+#[inline]
+pub fn consider<T: Real>(
+    objects: &[Object<T>],
+    ray: &Ray<T>,
+    method: Method,
+    index: usize,
+    nearest: &mut Option<Hit<T>>,
+) {
+    if let Some(t) = objects[index].intersect(ray, method) {
+        if nearest.is_none_or(|n| t < n.t || (t == n.t && index < n.object)) {
+            *nearest = Some(Hit { t, object: index });
+        }
+    }
+}
+
 impl<T: Real> Object<T> {
     /// The point of the surface nearest to `p`, a point computed to be on it:
     /// moved along the sphere's radius, or along the plane's normal.
