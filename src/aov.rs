@@ -11,10 +11,15 @@
 //! | `depth` | `intersection` on | distance along the primary ray to the first hit (the ray's `t`; the direction is a unit vector, so this is the distance from the camera); `+∞` on a miss |
 //! | `normal` | `intersection` on | unit world-space normal at the first hit (outward for a sphere, towards the camera for a plane); `(0, 0, 0)` on a miss |
 //! | `shadow` | `intersection` on | `1` lit, `0` in shadow, `−1` on a miss. Before the `shadow` stage is on no shadow ray is cast, so every hit reads `1` |
+//! | `object` | `intersection` on | index of the object hit first, among the objects in play (spheres in file order, then the `[[plane]]` entries); `−1` on a miss |
+//! | `ambient`, `diffuse`, `specular` | `blinn-phong` on | the three Blinn-Phong terms of the first hit (`ka·la`, `kd·ld·(L·N)`, `ks·ls·(N·H)^(shininess/4)`), as added to the pixel; `0` in shadow and on a miss, where none is computed |
+//! | `bounces` | `reflection` on | reflected rays the pixel's path traced: 0 to `max_depth − 1` |
+//! | `rays` | `intersection` on | every ray the pixel traced (primary, shadow and reflected, of every sample): where the time goes |
 
 use crate::camera::Camera;
 use crate::real::{Precision, Vector};
 use crate::render::Rays;
+use crate::stages::Stages;
 use crate::Vec3;
 
 /// One buffer, named as its PNG file is.
@@ -30,16 +35,34 @@ pub enum Buffer {
     Normal,
     /// Lit, shadowed or missed.
     Shadow,
+    /// Which object the primary ray hit first.
+    Object,
+    /// Blinn-Phong's ambient term at the first hit.
+    Ambient,
+    /// Blinn-Phong's diffuse term at the first hit.
+    Diffuse,
+    /// Blinn-Phong's specular term at the first hit.
+    Specular,
+    /// Reflected rays along the pixel's path.
+    Bounces,
+    /// Rays the pixel traced.
+    Rays,
 }
 
 impl Buffer {
     /// Every buffer, in the order files are written.
-    pub const ALL: [Buffer; 5] = [
+    pub const ALL: [Buffer; 11] = [
         Buffer::Beauty,
         Buffer::Direction,
         Buffer::Depth,
         Buffer::Normal,
         Buffer::Shadow,
+        Buffer::Object,
+        Buffer::Ambient,
+        Buffer::Diffuse,
+        Buffer::Specular,
+        Buffer::Bounces,
+        Buffer::Rays,
     ];
 
     /// The name of the buffer and of its PNG file (without `.png`).
@@ -50,14 +73,28 @@ impl Buffer {
             Buffer::Depth => "depth",
             Buffer::Normal => "normal",
             Buffer::Shadow => "shadow",
+            Buffer::Object => "object",
+            Buffer::Ambient => "ambient",
+            Buffer::Diffuse => "diffuse",
+            Buffer::Specular => "specular",
+            Buffer::Bounces => "bounces",
+            Buffer::Rays => "rays",
         }
     }
 
-    /// Does a render with the `intersection` stage on (or off) write this buffer?
-    pub fn written(self, intersection: bool) -> bool {
+    /// Does a render of `stages` write this buffer? Only what a stage computes is
+    /// written: no Blinn-Phong terms before that stage, no bounces before
+    /// reflection.
+    pub fn written(self, stages: Stages) -> bool {
         match self {
             Buffer::Beauty | Buffer::Direction => true,
-            Buffer::Depth | Buffer::Normal | Buffer::Shadow => intersection,
+            Buffer::Depth | Buffer::Normal | Buffer::Shadow | Buffer::Object | Buffer::Rays => {
+                stages.intersection
+            }
+            Buffer::Ambient | Buffer::Diffuse | Buffer::Specular => {
+                stages.intersection && stages.blinn_phong
+            }
+            Buffer::Bounces => stages.intersection && stages.reflection,
         }
     }
 }
@@ -74,12 +111,22 @@ pub struct FirstHit {
     pub lit: bool,
     /// Index of the object hit, among the objects in play.
     pub object: usize,
+    /// `L·N` of Blinn-Phong's diffuse term; 0 where none was computed (the
+    /// stage off, or the point in shadow).
+    pub diffuse: f64,
+    /// `(N·H)^(shininess/4)` of its specular term; 0 where none was computed.
+    pub specular: f64,
 }
 // ANCHOR_END: first_hit
 
+/// The `object` of a pixel whose primary ray hit nothing.
+pub const NO_OBJECT: u32 = u32::MAX;
+
 /// Everything the render keeps of one pixel, in float32: enough for every buffer
 /// but `direction`, which the camera gives again for any pixel
-/// ([`Frame::direction`]). 32 bytes.
+/// ([`Frame::direction`]). The Blinn-Phong terms are kept as their factors `L·N`
+/// and `(N·H)^(shininess/4)`; the colours they multiply are the object's
+/// ([`Frame::term_colours`]). 48 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PixelRecord {
     /// The beauty colour, clipped to [0, 1].
@@ -90,22 +137,43 @@ pub struct PixelRecord {
     pub normal: [f32; 3],
     /// 1 lit, 0 in shadow, −1 on a miss.
     pub shadow: f32,
+    /// The object hit first, [`NO_OBJECT`] on a miss.
+    pub object: u32,
+    /// `L·N` at the first hit, 0 where Blinn-Phong was not computed.
+    pub diffuse: f32,
+    /// `(N·H)^(shininess/4)` at the first hit, 0 where Blinn-Phong was not computed.
+    pub specular: f32,
+    /// Reflected rays the path traced.
+    pub bounces: u32,
+    /// Every ray the pixel traced.
+    pub rays: u32,
 }
 
 impl PixelRecord {
-    /// The record of a pixel that ended with `colour` and whose first hit (if any)
-    /// was `first`.
-    pub fn new(colour: Vec3, first: Option<FirstHit>) -> PixelRecord {
-        let (depth, normal, shadow) = match first {
-            Some(hit) => (hit.depth, hit.normal, if hit.lit { 1.0 } else { 0.0 }),
-            None => (f64::INFINITY, Vec3::ZERO, -1.0),
-        };
-        PixelRecord {
+    /// The record of a pixel that ended with `colour`, whose first hit (if any)
+    /// was `first`, whose path bounced `bounces` times and which traced `rays`.
+    pub fn new(colour: Vec3, first: Option<FirstHit>, bounces: u64, rays: u64) -> PixelRecord {
+        let count = |n: u64| u32::try_from(n).unwrap_or(u32::MAX);
+        let mut record = PixelRecord {
             colour: colour.as_vec3().to_array(),
-            depth: depth as f32,
-            normal: normal.as_vec3().to_array(),
-            shadow,
+            depth: f32::INFINITY,
+            normal: [0.0; 3],
+            shadow: -1.0,
+            object: NO_OBJECT,
+            diffuse: 0.0,
+            specular: 0.0,
+            bounces: count(bounces),
+            rays: count(rays),
+        };
+        if let Some(hit) = first {
+            record.depth = hit.depth as f32;
+            record.normal = hit.normal.as_vec3().to_array();
+            record.shadow = if hit.lit { 1.0 } else { 0.0 };
+            record.object = count(hit.object as u64);
+            record.diffuse = hit.diffuse as f32;
+            record.specular = hit.specular as f32;
         }
+        record
     }
 
     /// Did the primary ray hit anything?
@@ -121,8 +189,11 @@ pub struct Frame {
     pub width: u32,
     /// Rows.
     pub height: u32,
-    /// Was the `intersection` stage on (so that depth, normal and shadow mean something)?
-    pub has_surface_buffers: bool,
+    /// The stages that made it (which decide the buffers it has).
+    pub stages: Stages,
+    /// For each object in play, the colours its Blinn-Phong terms multiply:
+    /// `ka·la`, `kd·ld` and `ks·ls`.
+    pub term_colours: Vec<[Vec3; 3]>,
     /// The camera that made the primary rays.
     pub camera: Camera,
     /// The precision they were computed in.
@@ -136,11 +207,12 @@ pub struct Frame {
 impl Frame {
     /// A frame of `camera`'s size with every record blank, to render into.
     pub fn blank(camera: Camera, precision: Precision) -> Frame {
-        let blank = PixelRecord::new(Vec3::ZERO, None);
+        let blank = PixelRecord::new(Vec3::ZERO, None, 0, 0);
         Frame {
             width: camera.width,
             height: camera.height,
-            has_surface_buffers: false,
+            stages: Stages::up_to(crate::stages::Stage::Rays),
+            term_colours: Vec::new(),
             camera,
             precision,
             rays: Rays::default(),
@@ -165,8 +237,27 @@ impl Frame {
 
     /// The buffers this frame holds, in file order.
     pub fn buffers(&self) -> impl Iterator<Item = Buffer> + '_ {
-        Buffer::ALL
-            .into_iter()
-            .filter(|b| b.written(self.has_surface_buffers))
+        Buffer::ALL.into_iter().filter(|b| b.written(self.stages))
+    }
+
+    /// Does the frame hold `buffer`?
+    pub fn has(&self, buffer: Buffer) -> bool {
+        buffer.written(self.stages)
+    }
+
+    /// The ambient, diffuse and specular terms of `record`'s first hit, as they
+    /// were added to its colour (zero where none was computed).
+    pub fn terms(&self, record: &PixelRecord) -> [[f32; 3]; 3] {
+        let lit = record.shadow == 1.0 && self.stages.blinn_phong;
+        match self.term_colours.get(record.object as usize) {
+            Some([ambient, diffuse, specular]) if lit => [
+                ambient.as_vec3().to_array(),
+                (*diffuse * f64::from(record.diffuse)).as_vec3().to_array(),
+                (*specular * f64::from(record.specular))
+                    .as_vec3()
+                    .to_array(),
+            ],
+            _ => [[0.0; 3]; 3],
+        }
     }
 }

@@ -46,6 +46,9 @@ pub enum Command {
     Stages(StagesArgs),
     /// Render one set of stages into DIR/: beauty, buffers as PNG, and buffers.exr.
     Render(RenderArgs),
+    /// Tell the whole story of one pixel: the primary ray, every object's test,
+    /// the nearest hit, the shadow ray, each Blinn-Phong term, each bounce, the colour.
+    Explain(ExplainArgs),
     /// Check a scene file and print what it contains.
     Check(CheckArgs),
     /// Compare the beauty of two renders (their buffers.exr files), pixel by pixel.
@@ -66,6 +69,30 @@ pub enum Command {
     /// (or, with --scale, time against the number of spheres): a CSV, an SVG and a
     /// PNG. Default: the built-in scene at 960 × 540.
     Chart(ChartArgs),
+}
+
+/// Arguments of `raystep explain`.
+#[derive(Args, Debug)]
+pub struct ExplainArgs {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub frame: FrameArgs,
+    /// The pixel: column and row from the top-left corner, e.g. 150,120.
+    #[arg(long, value_parser = parse_pixel)]
+    pub pixel: (u32, u32),
+    /// Print one JSON object instead of the story in words (`depth`: the first
+    /// hit's distance, null on a miss).
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `X,Y` as two whole numbers.
+fn parse_pixel(text: &str) -> Result<(u32, u32), String> {
+    let usage = || format!("`{text}`: expected X,Y, two whole numbers such as 150,120");
+    let (x, y) = text.split_once(',').ok_or_else(usage)?;
+    let x = x.trim().parse().map_err(|_| usage())?;
+    let y = y.trim().parse().map_err(|_| usage())?;
+    Ok((x, y))
 }
 
 /// Arguments of `raystep chart`.
@@ -283,6 +310,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         None => stages(StagesArgs::default_out()),
         Some(Command::Stages(args)) => stages(args),
         Some(Command::Render(args)) => render_one(args),
+        Some(Command::Explain(args)) => explain(&args),
         Some(Command::Check(args)) => check(&args.scene),
         Some(Command::Diff(args)) => diff(&args),
         Some(Command::Figures(args)) => figures(&args),
@@ -378,6 +406,9 @@ pub fn load_scene(args: &SceneArgs) -> Result<(Scene, String), Error> {
     Ok((scene, scene_name(args)))
 }
 
+/// The contact sheet `raystep stages` writes: a row per stage, a column per buffer.
+pub const CONTACT_SHEET: &str = "contact-sheet.png";
+
 fn stages(args: StagesArgs) -> Result<(), Error> {
     let (mut scene, name) = load_scene(&args.scene)?;
     let base = args.rules.apply(&mut scene, Stages::ALL)?;
@@ -385,6 +416,8 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
     say!("{name}: every stage at {} × {}", scene.width, scene.height);
     let bar = progress_bar(u64::from(scene.height) * Stage::ALL.len() as u64);
     let start = Instant::now();
+    let mut page = Vec::new(); // a row of index.html per stage
+    let mut sheet = crate::contact::ContactSheet::new(crate::contact::THUMBNAIL_WIDTH);
     for stage in Stage::ALL {
         bar.set_message(stage.folder());
         let dir = args.out.join(stage.folder());
@@ -394,14 +427,61 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
         };
         let (frame, seconds) = timed(|| render(&scene, &settings, &|n| bar.inc(n)));
         write(&frame, &dir, seconds, &bar)?;
+        // The numbers behind the pictures, for the page.
+        crate::page::write_pixels(&dir, &stage.folder(), &frame)?;
+        let label = stage.label();
+        sheet.add_row(&label, &frame);
+        page.push(crate::page::PageStage {
+            folder: stage.folder(),
+            label,
+            buffers: frame.buffers().map(|b| b.name().to_string()).collect(),
+        });
+        // One frame at a time: at 1920 × 1080 a frame is about 100 MB.
+        drop(frame);
     }
     bar.finish_and_clear();
+    let contact = args.out.join(CONTACT_SHEET);
+    crate::output::write_atomically(&contact, &sheet.png())?;
+    let index = crate::page::write_index(&args.out, &name, scene.width, scene.height, &page)?;
     say!(
         "wrote {} stages into {}/ in {:.2} s",
         Stage::ALL.len(),
         args.out.display(),
         start.elapsed().as_secs_f64()
     );
+    say!(
+        "open {} to look through every stage and buffer ({} has them on one sheet)",
+        index.display(),
+        contact.display()
+    );
+    Ok(())
+}
+
+fn explain(args: &ExplainArgs) -> Result<(), Error> {
+    let (scene, settings) = prepare(&args.frame)?;
+    let (x, y) = args.pixel;
+    if x >= scene.width || y >= scene.height {
+        return Err(Error::Usage(format!(
+            "--pixel {x},{y} is outside the {} × {} image: x runs from 0 to {} and y from 0 to {}",
+            scene.width,
+            scene.height,
+            scene.width - 1,
+            scene.height - 1
+        )));
+    }
+    let story = crate::explain::explain(&scene, &settings, x, y);
+    if args.json {
+        let json = serde_json::to_string_pretty(&story).expect("an explanation is plain data");
+        say!("{json}");
+    } else {
+        say!(
+            "{}: {} × {}",
+            scene_name(&args.frame.scene),
+            scene.width,
+            scene.height
+        );
+        say!("{story}");
+    }
     Ok(())
 }
 

@@ -22,7 +22,7 @@ pub struct Figure {
     pub buffers: &'static [Buffer],
 }
 
-use Buffer::{Beauty, Depth, Normal, Shadow};
+use Buffer::{Ambient, Beauty, Bounces, Depth, Diffuse, Normal, Object, Rays, Shadow, Specular};
 
 /// Every figure of the book, by chapter.
 #[rustfmt::skip]
@@ -58,7 +58,43 @@ pub const FIGURES: &[Figure] = &[
     fig("ch09/x0001-auto", "render scenes/stress/seed-x0.001.toml", &[Shadow]),
     fig("ch09/plane-no-step", "render scenes/stress/horizon-true.toml --offset fixed:0", &[Beauty, Shadow]),
     fig("ch09/plane-auto", "render scenes/stress/horizon-true.toml", &[Beauty, Shadow]),
+    fig("ch11/seed", "render scenes/seed.toml", &[Beauty, Object, Shadow, Ambient, Diffuse, Specular, Bounces, Rays]),
 ];
+
+/// The contact sheet of chapter 11 and the README, under `chapters/img/`: what
+/// `raystep stages` writes as `out/contact-sheet.png` for the built-in scene.
+pub const CONTACT_SHEET: &str = "ch11/contact-sheet.png";
+
+/// [`CONTACT_SHEET`]'s bytes: every stage of the built-in scene, as `raystep
+/// stages` renders them.
+pub fn contact_sheet() -> Vec<u8> {
+    let scene = crate::scene_file::seed();
+    let mut sheet = crate::contact::ContactSheet::new(crate::contact::THUMBNAIL_WIDTH);
+    for stage in crate::stages::Stage::ALL {
+        let settings = crate::render::Settings::from(crate::stages::Stages::up_to(stage));
+        sheet.add_row(
+            &stage.label(),
+            &crate::render::render(&scene, &settings, &|_| {}),
+        );
+    }
+    sheet.png()
+}
+
+/// Every file `raystep figures` writes under `chapters/img/`: (file, bytes).
+fn every_file(root: &Path) -> Result<Vec<(String, Vec<u8>, String)>, Error> {
+    let mut files = Vec::new();
+    for figure in FIGURES {
+        for (file, bytes) in figure.render(root)? {
+            files.push((file, bytes, format!("raystep {}", figure.args)));
+        }
+    }
+    files.push((
+        CONTACT_SHEET.to_string(),
+        contact_sheet(),
+        "raystep stages".to_string(),
+    ));
+    Ok(files)
+}
 
 const fn fig(name: &'static str, args: &'static str, buffers: &'static [Buffer]) -> Figure {
     Figure {
@@ -106,18 +142,16 @@ pub fn render_command(args: &str, root: &Path) -> Result<Frame, Error> {
 /// relative to `root`. Returns the files written.
 pub fn write_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>, Error> {
     let mut written = Vec::new();
-    for figure in FIGURES {
-        for (file, bytes) in figure.render(root)? {
-            let path = out.join(file);
-            if let Some(dir) = path.parent() {
-                std::fs::create_dir_all(dir).map_err(|e| Error::Output {
-                    path: dir.to_path_buf(),
-                    message: e.to_string(),
-                })?;
-            }
-            crate::output::write_atomically(&path, &bytes)?;
-            written.push(path);
+    for (file, bytes, _) in every_file(root)? {
+        let path = out.join(file);
+        if let Some(dir) = path.parent() {
+            std::fs::create_dir_all(dir).map_err(|e| Error::Output {
+                path: dir.to_path_buf(),
+                message: e.to_string(),
+            })?;
         }
+        crate::output::write_atomically(&path, &bytes)?;
+        written.push(path);
     }
     Ok(written)
 }
@@ -127,19 +161,16 @@ pub fn write_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>, Error> {
 pub fn check_all(root: &Path, out: &Path) -> Result<Vec<String>, Error> {
     let mut problems = Vec::new();
     let mut expected = Vec::new();
-    for figure in FIGURES {
-        for (file, bytes) in figure.render(root)? {
-            let path = out.join(&file);
-            match std::fs::read(&path) {
-                Err(_) => problems.push(format!("{file}: missing (raystep {})", figure.args)),
-                Ok(found) if found != bytes => problems.push(format!(
-                    "{file}: differs from what `raystep {}` renders now",
-                    figure.args
-                )),
-                Ok(_) => {}
+    for (file, bytes, command) in every_file(root)? {
+        let path = out.join(&file);
+        match std::fs::read(&path) {
+            Err(_) => problems.push(format!("{file}: missing ({command})")),
+            Ok(found) if found != bytes => {
+                problems.push(format!("{file}: differs from what `{command}` renders now"))
             }
-            expected.push(path);
+            Ok(_) => {}
         }
+        expected.push(path);
     }
     for path in png_files(out) {
         if !expected.contains(&path) {

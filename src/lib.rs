@@ -37,7 +37,9 @@ pub mod shade;
 pub mod plane;
 // The switches, the pixel loop and what it writes.
 pub mod aov;
+pub mod contact;
 pub mod output;
+pub mod page;
 pub mod render;
 pub mod stages;
 // Speed: skipping tests that cannot succeed.
@@ -50,6 +52,7 @@ pub mod chart;
 pub mod cli;
 pub mod compare;
 pub mod error;
+pub mod explain;
 pub mod figures;
 pub mod generate;
 pub mod yardstick;

@@ -250,12 +250,18 @@ impl<T: Real> Tracer<T> {
                 primary: 1,
                 ..Rays::default()
             };
-            return (PixelRecord::new(colour, None), rays);
+            return (PixelRecord::new(colour, None, 0, 1), rays);
         }
         let candidates = self.masks.mask(row, col);
         let traced = self.trace(ray, candidates);
         if self.spp == 1 {
-            return (PixelRecord::new(traced.colour, traced.first), traced.rays);
+            let record = PixelRecord::new(
+                traced.colour,
+                traced.first,
+                traced.rays.reflection,
+                traced.rays.total(),
+            );
+            return (record, traced.rays);
         }
         // ANCHOR: samples
         // Several samples: the colour is their mean; the buffers keep the centre
@@ -270,7 +276,11 @@ impl<T: Real> Tracer<T> {
             rays += traced.rays;
         }
         let colour = sum / f64::from(self.spp);
-        (PixelRecord::new(colour, traced.first), rays)
+        let bounces = traced.rays.reflection;
+        (
+            PixelRecord::new(colour, traced.first, bounces, rays.total()),
+            rays,
+        )
         // ANCHOR_END: samples
     }
     // ANCHOR_END: pixel
@@ -316,31 +326,34 @@ impl<T: Real> Tracer<T> {
                 !self.in_shadow(shifted, to_light, light_distance)
             };
             // ANCHOR_END: shadow_test
+
+            // ANCHOR: shading
+            // Blinn-Phong, seen from the camera (on every bounce, as in the tutorial),
+            // at a lit point.
+            let terms = (lit && self.stages.blinn_phong).then(|| {
+                let viewer = match self.viewer {
+                    Viewer::Camera => T::Vec3::of(self.camera.position),
+                    Viewer::RayOrigin => ray.origin,
+                };
+                let to_viewer = (viewer - point).normalize();
+                blinn_phong::terms(&object.material, &self.light, normal, to_light, to_viewer)
+            });
+            // ANCHOR_END: shading
             if segment == 0 {
                 first = Some(FirstHit {
                     depth: hit.t.to_f64(),
                     normal: normal.to_f64(),
                     lit,
                     object: hit.object,
+                    diffuse: terms.map_or(0.0, |t| t.l_dot_n.to_f64()),
+                    specular: terms.map_or(0.0, |t| t.highlight.to_f64()),
                 });
             }
             if !lit {
                 break;
             }
-
-            // ANCHOR: shading
-            // Blinn-Phong, seen from the camera (on every bounce, as in the tutorial).
-            let illumination = if self.stages.blinn_phong {
-                let viewer = match self.viewer {
-                    Viewer::Camera => T::Vec3::of(self.camera.position),
-                    Viewer::RayOrigin => ray.origin,
-                };
-                let to_viewer = (viewer - point).normalize();
-                blinn_phong::illuminate(&object.material, &self.light, normal, to_light, to_viewer)
-            } else {
-                object.material.diffuse
-            };
-            // ANCHOR_END: shading
+            // Without Blinn-Phong, the object's flat diffuse colour.
+            let illumination = terms.map_or(object.material.diffuse, |t| t.sum());
             // ANCHOR: accumulate
             // Reflection: add this segment's light, weighted, and bounce.
             colour += illumination * weight;
@@ -504,7 +517,19 @@ fn render_in<T: Real>(
             a += b;
             a
         });
-    frame.has_surface_buffers = settings.stages.intersection;
+    frame.stages = settings.stages;
+    frame.term_colours = tracer
+        .objects
+        .iter()
+        .map(|o| {
+            let (m, l) = (o.exact().material, &scene.light);
+            [
+                m.ambient * l.ambient,
+                m.diffuse * l.diffuse,
+                m.specular * l.specular,
+            ]
+        })
+        .collect();
     frame.camera = tracer.camera;
     frame.precision = settings.precision;
     frame.rays = rays;

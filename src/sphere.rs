@@ -117,6 +117,23 @@ impl<T: Real> Sphere<T> {
 }
 // ANCHOR_END: stable
 
+impl<T: Real> Sphere<T> {
+    /// The textbook discriminant `Δ = b² − 4c` of [`Sphere::roots_naive`], as it
+    /// computes it (for `raystep explain`).
+    pub fn discriminant_naive(&self, ray: &Ray<T>) -> T {
+        let oc = ray.origin - self.center;
+        let b = T::of(2.0) * ray.direction.dot(oc);
+        b * b - T::of(4.0) * (oc.length_squared() - self.radius * self.radius)
+    }
+
+    /// `Δ/4 = r² − ‖f + h·d‖²` of [`Sphere::roots_stable`], as it computes it.
+    pub fn quarter_discriminant(&self, ray: &Ray<T>) -> T {
+        let f = ray.origin - self.center;
+        let h = -ray.direction.dot(f);
+        self.radius * self.radius - (f + ray.direction * h).length_squared()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -56,6 +56,11 @@ impl Stage {
         format!("{:02}-{}", self.number(), self.name())
     }
 
+    /// Its label on the contact sheet and the page, e.g. `3 shadow`.
+    pub fn label(self) -> String {
+        format!("{} {}", self.number(), self.name())
+    }
+
     /// The stage this one cannot work without, if any.
     pub fn needs(self) -> Option<Stage> {
         match self {

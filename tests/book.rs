@@ -52,12 +52,12 @@ fn includes(text: &str) -> Vec<(String, Option<String>)> {
 }
 
 #[test]
-fn every_chapter_file_is_in_the_summary_and_there_are_ten_chapters() {
+fn every_chapter_file_is_in_the_summary_and_there_are_eleven_chapters() {
     let listed: Vec<String> = chapters().into_iter().map(|(n, _)| n).collect();
     assert_eq!(
         listed.len(),
-        11,
-        "the introduction and ten chapters: {listed:?}"
+        12,
+        "the introduction and eleven chapters: {listed:?}"
     );
     for entry in std::fs::read_dir(root().join("chapters")).unwrap() {
         let name = entry.unwrap().file_name().to_string_lossy().into_owned();
@@ -82,8 +82,18 @@ fn every_include_names_a_file_and_anchor_with_text() {
             let file = root().join("chapters").join(&path);
             let source = std::fs::read_to_string(&file)
                 .unwrap_or_else(|e| panic!("{name}: {{{{#include {path}}}}}: {e}"));
+            // mdBook's line ranges: `file:5:` is line 5 to the end.
+            let lines_from = anchor
+                .as_deref()
+                .and_then(|a| a.strip_suffix(':'))
+                .and_then(|n| n.parse::<usize>().ok());
             let included = match &anchor {
                 None => source.clone(),
+                Some(_) if lines_from.is_some() => source
+                    .lines()
+                    .skip(lines_from.unwrap() - 1)
+                    .collect::<Vec<_>>()
+                    .join("\n"),
                 Some(anchor) => {
                     let start = format!("ANCHOR: {anchor}");
                     let end = format!("ANCHOR_END: {anchor}");
@@ -421,4 +431,33 @@ fn the_charts_shown_exist_and_their_numbers_are_the_csv_files() {
     assert_eq!(rmse("naive"), rmse("default"));
     assert_eq!(rmse("accel off"), rmse("default"));
     assert_eq!(rmse("early stop off"), rmse("default"));
+}
+
+#[test]
+fn chapter_11_tells_the_story_explain_tells_now() {
+    // The story is included from its insta snapshot (tests/explain.rs locks it);
+    // check that the snapshot's text starts at the line the chapter includes from.
+    let text = chapter("11");
+    let include = "{{#include ../tests/snapshots/explain__floor-in-shadow.snap:5:}}";
+    assert!(
+        text.contains(include),
+        "chapter 11 should include {include}"
+    );
+    let snap =
+        std::fs::read_to_string(root().join("tests/snapshots/explain__floor-in-shadow.snap"))
+            .unwrap();
+    let fifth = snap.lines().nth(4).unwrap();
+    assert!(fifth.starts_with("pixel x = 74, y = 125"), "{fifth}");
+    assert!(text.contains("explain --pixel 74,125"));
+    let scene = raystep::scene_file::seed();
+    let settings = raystep::render::Settings::from(raystep::stages::Stages::ALL);
+    let story = raystep::explain::explain(&scene, &settings, 74, 125);
+    assert!(snap.contains(story.to_string().trim_end()));
+    // What the chapter reads off the story.
+    for quoted in ["at t = 4.65", "12.17 away", "at 2.78", "1.7e-11"] {
+        assert!(text.contains(quoted), "chapter 11 should say {quoted:?}");
+    }
+    assert!(story
+        .to_string()
+        .contains("object 0 at 2.78469 < 12.1712: in shadow"));
 }

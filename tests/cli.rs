@@ -50,6 +50,12 @@ fn no_arguments_renders_every_stage_of_the_built_in_scene_from_any_folder() {
                 "depth.png",
                 "normal.png",
                 "shadow.png",
+                "object.png",
+                "ambient.png",
+                "diffuse.png",
+                "specular.png",
+                "bounces.png",
+                "rays.png",
                 "buffers.exr",
             ][..],
         ),
@@ -66,8 +72,14 @@ fn no_arguments_renders_every_stage_of_the_built_in_scene_from_any_folder() {
         png_size(&dir.path().join("out/06-plane/beauty.png")),
         (300, 200)
     );
-    let folders = std::fs::read_dir(dir.path().join("out")).unwrap().count();
+    let folders = std::fs::read_dir(dir.path().join("out"))
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().path().is_dir())
+        .count();
     assert_eq!(folders, 6);
+    for file in ["index.html", "contact-sheet.png"] {
+        assert!(dir.path().join("out").join(file).is_file(), "{file}");
+    }
 }
 
 #[test]
@@ -99,12 +111,18 @@ fn render_writes_one_configuration_at_the_size_asked_and_no_temporary_files() {
     assert_eq!(
         names,
         [
+            "ambient.png",
             "beauty.png",
+            "bounces.png",
             "buffers.exr",
             "depth.png",
+            "diffuse.png",
             "direction.png",
             "normal.png",
-            "shadow.png"
+            "object.png",
+            "rays.png",
+            "shadow.png",
+            "specular.png"
         ]
     );
     assert_eq!(png_size(&dir.path().join("here/depth.png")), (64, 48));

@@ -15,7 +15,46 @@ pub enum Viewer {
 }
 
 // ANCHOR: illuminate
-/// The light a point reflects towards the viewer.
+/// The light a point reflects towards the viewer: the sum of its three
+/// [`Terms`].
+#[inline]
+pub fn illuminate<T: Real>(
+    material: &Material<T>,
+    light: &Light<T>,
+    normal: T::Vec3,
+    to_light: T::Vec3,
+    to_viewer: T::Vec3,
+) -> T::Vec3 {
+    terms(material, light, normal, to_light, to_viewer).sum()
+}
+
+/// The three terms of Blinn-Phong at one point, and the factors they come from
+/// (what `raystep explain` prints and the `diffuse` and `specular` buffers hold).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Terms<T: Real = f64> {
+    /// `ka·la`: light that reaches everything.
+    pub ambient: T::Vec3,
+    /// `kd·ld·(L·N)`.
+    pub diffuse: T::Vec3,
+    /// `ks·ls·(N·H)^(shininess/4)`.
+    pub specular: T::Vec3,
+    /// `L·N`, the cosine of the angle between the light and the normal.
+    pub l_dot_n: T,
+    /// `N·H`, clamped at 0: how close the half vector is to the normal.
+    pub n_dot_h: T,
+    /// `(N·H)^(shininess/4)`, the highlight's strength.
+    pub highlight: T,
+}
+
+impl<T: Real> Terms<T> {
+    /// ambient + diffuse + specular.
+    #[inline]
+    pub fn sum(&self) -> T::Vec3 {
+        self.ambient + self.diffuse + self.specular
+    }
+}
+
+/// The terms of Blinn-Phong at a point.
 ///
 /// `normal` is the surface normal N, `to_light` the unit vector L towards the light
 /// and `to_viewer` the unit vector V towards the camera. With the half vector
@@ -28,22 +67,25 @@ pub enum Viewer {
 /// fractional exponent would give NaN, and on the tutorial's scene the clamp moves
 /// no pixel by more than 3e-12.
 #[inline]
-pub fn illuminate<T: Real>(
+pub fn terms<T: Real>(
     material: &Material<T>,
     light: &Light<T>,
     normal: T::Vec3,
     to_light: T::Vec3,
     to_viewer: T::Vec3,
-) -> T::Vec3 {
-    let ambient = material.ambient * light.ambient;
-    let diffuse = material.diffuse * light.diffuse * to_light.dot(normal);
+) -> Terms<T> {
+    let l_dot_n = to_light.dot(normal);
     let half = (to_light + to_viewer).normalize();
-    let highlight = power(
-        normal.dot(half).max(T::of(0.0)),
-        material.shininess / T::of(4.0),
-    );
-    let specular = material.specular * light.specular * highlight;
-    ambient + diffuse + specular
+    let n_dot_h = normal.dot(half).max(T::of(0.0));
+    let highlight = power(n_dot_h, material.shininess / T::of(4.0));
+    Terms {
+        ambient: material.ambient * light.ambient,
+        diffuse: material.diffuse * light.diffuse * l_dot_n,
+        specular: material.specular * light.specular * highlight,
+        l_dot_n,
+        n_dot_h,
+        highlight,
+    }
 }
 // ANCHOR_END: illuminate
 

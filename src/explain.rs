@@ -1,0 +1,623 @@
+//! `raystep explain`: the whole story of one pixel, in the tutorial's terms.
+//!
+//! The story is told by following the pixel's path again with the same functions
+//! the render calls (the intersection methods, the offset, the shadow test,
+//! Blinn-Phong, the reflection), writing down every number on the way. It uses the
+//! plain loop over the objects: the tile masks and the BVH never change a result
+//! (`tests/speed.rs`), and the plain loop is the one whose every test can be told.
+//! `tests/explain.rs` checks, pixel by pixel, that the story ends where the render
+//! did.
+
+use serde::Serialize;
+
+use crate::ray::Ray;
+use crate::real::{Real, Vector};
+use crate::render::{Settings, Tracer, HALF_STEP};
+use crate::scene::{nearest_hit, Object, Role, Scene, Shape};
+use crate::shade::blinn_phong::{self, Viewer};
+use crate::shade::{reflection, shadow};
+use crate::sphere::Method;
+use crate::Vec3;
+
+/// Everything that happened to one pixel.
+#[derive(Clone, Debug, Serialize)]
+pub struct Explanation {
+    /// Column.
+    pub x: u32,
+    /// Row, from the top.
+    pub y: u32,
+    /// The stages that were on, e.g. `rays+intersection+shadow`.
+    pub stages: String,
+    /// Precision, intersection method, offset and early stop, in words.
+    pub rules: String,
+    /// The pixel's point on the screen rectangle.
+    pub screen_point: [f64; 3],
+    /// The primary ray: the camera towards the screen point.
+    pub primary: RayInfo,
+    /// Distance along the primary ray to its first hit; `None` on a miss.
+    pub depth: Option<f64>,
+    /// Each segment of the path: the primary ray, then its reflections.
+    pub segments: Vec<Segment>,
+    /// Why the path ended.
+    pub end: String,
+    /// The weighted sum of the segments' light, before clipping.
+    pub unclipped: [f64; 3],
+    /// The same clipped to [0, 1]: the pixel (with one sample per pixel).
+    pub colour: [f64; 3],
+    /// With several samples per pixel: their mean, which is the pixel; this story
+    /// follows the centre ray, which gives the buffers.
+    pub samples: Option<Samples>,
+    /// Rays traced by this path: primary, shadow, reflection.
+    pub rays: [u64; 3],
+}
+
+/// The samples of a pixel rendered with `--spp` above 1.
+#[derive(Clone, Debug, Serialize)]
+pub struct Samples {
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Their mean colour: the pixel.
+    pub colour: [f64; 3],
+    /// Rays traced by all of them and the centre ray.
+    pub rays: u64,
+}
+
+/// A ray, in float64.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct RayInfo {
+    /// Where it starts.
+    pub origin: [f64; 3],
+    /// Its unit direction.
+    pub direction: [f64; 3],
+}
+
+/// One segment of a path: a ray, what it meets, and the light it brings back.
+#[derive(Clone, Debug, Serialize)]
+pub struct Segment {
+    /// 0 for the primary ray, then 1, 2, … for the reflections.
+    pub index: u32,
+    /// The ray.
+    pub ray: RayInfo,
+    /// How much of this segment's light reaches the pixel.
+    pub weight: f64,
+    /// The test of every object against the ray.
+    pub tests: Vec<ObjectTest>,
+    /// The nearest object hit, if any.
+    pub hit: Option<HitInfo>,
+}
+
+/// The test of one object against one ray.
+#[derive(Clone, Debug, Serialize)]
+pub struct ObjectTest {
+    /// Index among the objects in play.
+    pub object: usize,
+    /// What the object is, e.g. `sphere, centre (…), radius 0.7`.
+    pub what: String,
+    /// For a sphere: the discriminant as the method computes it (`Δ = b² − 4c` for
+    /// the naive method, `Δ/4 = r² − ‖f + h·d‖²` for the stable one).
+    pub discriminant: Option<f64>,
+    /// The roots, smaller first, when the discriminant is positive (a plane: its
+    /// one crossing).
+    pub roots: Vec<f64>,
+    /// The distance if the object is hit.
+    pub t: Option<f64>,
+    /// Hit or miss and why, in words.
+    pub verdict: String,
+}
+
+/// The nearest hit of a segment and what was computed at it.
+#[derive(Clone, Debug, Serialize)]
+pub struct HitInfo {
+    /// Index of the object hit.
+    pub object: usize,
+    /// Distance along the ray.
+    pub t: f64,
+    /// The hit point, `origin + t·direction`.
+    pub point: [f64; 3],
+    /// The unit normal there.
+    pub normal: [f64; 3],
+    /// The point moved off the surface, where new rays start.
+    pub shifted: [f64; 3],
+    /// How far it was moved.
+    pub offset: f64,
+    /// The shadow ray, when the shadow stage is on.
+    pub shadow: Option<ShadowInfo>,
+    /// Does the point see the light? (Always, before the shadow stage.)
+    pub lit: bool,
+    /// Blinn-Phong's terms, when that stage is on and the point is lit.
+    pub shading: Option<Shading>,
+    /// The light this segment adds before its weight: the three terms' sum, or the
+    /// flat diffuse colour without Blinn-Phong; `None` in shadow.
+    pub illumination: Option<[f64; 3]>,
+    /// The weighted sum of the path so far.
+    pub sum: [f64; 3],
+}
+
+/// The shadow ray of a hit point.
+#[derive(Clone, Debug, Serialize)]
+pub struct ShadowInfo {
+    /// From the shifted point, towards the light.
+    pub ray: RayInfo,
+    /// The light's distance, measured from the hit point.
+    pub light_distance: f64,
+    /// The nearest object the shadow ray meets, and where.
+    pub blocker: Option<(usize, f64)>,
+}
+
+/// Blinn-Phong at a lit point.
+#[derive(Clone, Debug, Serialize)]
+pub struct Shading {
+    /// L, towards the light.
+    pub to_light: [f64; 3],
+    /// V, towards the viewer.
+    pub to_viewer: [f64; 3],
+    /// `L·N`.
+    pub l_dot_n: f64,
+    /// `N·H`, clamped at 0.
+    pub n_dot_h: f64,
+    /// The exponent, `shininess / 4`.
+    pub exponent: f64,
+    /// `(N·H)^exponent`.
+    pub highlight: f64,
+    /// `ka·la`.
+    pub ambient: [f64; 3],
+    /// `kd·ld·(L·N)`.
+    pub diffuse: [f64; 3],
+    /// `ks·ls·(N·H)^exponent`.
+    pub specular: [f64; 3],
+}
+
+/// The story of pixel (`x`, `y`) of `scene` under `settings`.
+pub fn explain(scene: &Scene, settings: &Settings, x: u32, y: u32) -> Explanation {
+    match settings.precision {
+        crate::real::Precision::F32 => explain_in::<f32>(scene, settings, x, y),
+        crate::real::Precision::F64 => explain_in::<f64>(scene, settings, x, y),
+    }
+}
+
+fn explain_in<T: Real>(scene: &Scene, settings: &Settings, x: u32, y: u32) -> Explanation {
+    let tracer = Tracer::<T>::new(scene, settings);
+    let (row, col) = (y, x);
+    let primary = tracer.camera.primary_ray::<T>(row, col);
+    let mut story = Explanation {
+        x,
+        y,
+        stages: settings.stages.to_string(),
+        rules: rules(settings),
+        screen_point: tracer
+            .camera
+            .screen_point::<T>(row, col)
+            .to_f64()
+            .to_array(),
+        primary: info(&primary),
+        depth: None,
+        segments: Vec::new(),
+        end: String::new(),
+        unclipped: [0.0; 3],
+        colour: [0.0; 3],
+        samples: None,
+        rays: [1, 0, 0],
+    };
+    if !settings.stages.intersection {
+        let colour = (primary.direction.to_f64() + Vec3::ONE) * 0.5;
+        story.end = "only the rays stage is on: the colour shows the ray's direction, \
+                     each component mapped from [−1, 1] to [0, 1]"
+            .into();
+        story.unclipped = colour.to_array();
+        story.colour = colour.to_array();
+        return story;
+    }
+    let segments = if settings.stages.reflection {
+        tracer.max_depth
+    } else {
+        1
+    };
+    let mut sum = T::Vec3::ZERO;
+    let mut weight = T::of(1.0);
+    let mut ray = primary;
+    story.end = format!("the path used all {segments} of its segments");
+    for index in 0..segments {
+        if index > 0 {
+            story.rays[2] += 1;
+        }
+        let tests = tracer
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(i, o)| test(i, o, &ray, tracer.method))
+            .collect();
+        let mut segment = Segment {
+            index,
+            ray: info(&ray),
+            weight: weight.to_f64(),
+            tests,
+            hit: None,
+        };
+        let Some(hit) = nearest_hit(&tracer.objects, &ray, tracer.method) else {
+            story.end = if index == 0 {
+                "the primary ray hits nothing: the pixel is black (the tutorial has no sky colour)"
+                    .into()
+            } else {
+                format!("reflection {index} hits nothing: the sky adds no light")
+            };
+            story.segments.push(segment);
+            break;
+        };
+        let object = &tracer.objects[hit.object];
+        let point = ray.at(hit.t);
+        let normal = object.normal_at(point, &ray);
+        let shifted = shadow::step_off(point, normal, object, tracer.offset);
+        let to_light = (tracer.light.position - shifted).normalize();
+        let shadow = settings.stages.shadow.then(|| {
+            story.rays[1] += 1;
+            let light_distance = tracer.light.position.distance(point);
+            let shadow_ray = Ray {
+                origin: shifted,
+                direction: to_light,
+            };
+            let blocker = nearest_hit(&tracer.objects, &shadow_ray, tracer.method);
+            ShadowInfo {
+                ray: info(&shadow_ray),
+                light_distance: light_distance.to_f64(),
+                blocker: blocker.map(|b| (b.object, b.t.to_f64())),
+            }
+        });
+        let lit = shadow
+            .as_ref()
+            .is_none_or(|s| s.blocker.is_none_or(|(_, t)| t >= s.light_distance));
+        if index == 0 {
+            story.depth = Some(hit.t.to_f64());
+        }
+        let viewer = match tracer.viewer {
+            Viewer::Camera => T::Vec3::of(tracer.camera.position),
+            Viewer::RayOrigin => ray.origin,
+        };
+        let to_viewer = (viewer - point).normalize();
+        let terms = (lit && settings.stages.blinn_phong).then(|| {
+            blinn_phong::terms(&object.material, &tracer.light, normal, to_light, to_viewer)
+        });
+        let illumination = lit.then(|| terms.map_or(object.material.diffuse, |t| t.sum()));
+        if let Some(light) = illumination {
+            sum += light * weight;
+        }
+        segment.hit = Some(HitInfo {
+            object: hit.object,
+            t: hit.t.to_f64(),
+            point: point.to_f64().to_array(),
+            normal: normal.to_f64().to_array(),
+            shifted: shifted.to_f64().to_array(),
+            offset: (shifted - point).length().to_f64(),
+            shadow,
+            lit,
+            shading: terms.map(|t| Shading {
+                to_light: to_light.to_f64().to_array(),
+                to_viewer: to_viewer.to_f64().to_array(),
+                l_dot_n: t.l_dot_n.to_f64(),
+                n_dot_h: t.n_dot_h.to_f64(),
+                exponent: (object.material.shininess / T::of(4.0)).to_f64(),
+                highlight: t.highlight.to_f64(),
+                ambient: t.ambient.to_f64().to_array(),
+                diffuse: t.diffuse.to_f64().to_array(),
+                specular: t.specular.to_f64().to_array(),
+            }),
+            illumination: illumination.map(|c| c.to_f64().to_array()),
+            sum: sum.to_f64().to_array(),
+        });
+        story.segments.push(segment);
+        if !lit {
+            story.end = format!(
+                "the point of segment {index} does not see the light: the path ends there \
+                 and adds nothing more (the tutorial's rule)"
+            );
+            break;
+        }
+        weight = weight * object.material.reflection;
+        ray = reflection::reflected_ray(shifted, &ray, normal);
+        let left = (segments - index - 1) as usize;
+        if let Some(reach) = tracer.reach.get(left) {
+            if left > 0 && weight.to_f64() * reach < HALF_STEP {
+                story.end = format!(
+                    "early stop after segment {index}: the weight left, {}, times the most \
+                     {left} more segments can add, {}, is below half an 8-bit step",
+                    num(weight.to_f64()),
+                    num(*reach)
+                );
+                break;
+            }
+        }
+    }
+    story.unclipped = sum.to_f64().to_array();
+    story.colour = sum.clamp01().to_f64().to_array();
+    if tracer.spp > 1 {
+        let (record, rays) = tracer.pixel(row, col);
+        story.samples = Some(Samples {
+            spp: tracer.spp,
+            colour: record.colour.map(f64::from),
+            rays: rays.total(),
+        });
+    }
+    story
+}
+
+/// The test of object `index` against `ray`, with its numbers and verdict.
+fn test<T: Real>(index: usize, object: &Object<T>, ray: &Ray<T>, method: Method) -> ObjectTest {
+    let t = object.intersect(ray, method).map(Real::to_f64);
+    let role = match object.role {
+        Role::Sphere => "",
+        Role::Floor => " (the floor)",
+    };
+    match &object.shape {
+        Shape::Sphere(s) => {
+            let (discriminant, roots) = match method {
+                Method::Naive => (s.discriminant_naive(ray), s.roots_naive(ray)),
+                Method::Stable => (s.quarter_discriminant(ray), s.roots_stable(ray)),
+            };
+            let name = match method {
+                Method::Naive => "Δ",
+                Method::Stable => "Δ/4",
+            };
+            let d = discriminant.to_f64();
+            let roots: Vec<f64> = roots.map_or(Vec::new(), |(a, b)| vec![a.to_f64(), b.to_f64()]);
+            let verdict = match (t, roots.as_slice()) {
+                (Some(t), _) => format!("hit at t = {}", num(t)),
+                (None, []) if d == 0.0 => format!("miss: {name} = 0, the ray only touches it"),
+                (None, []) if d < 0.0 => format!("miss: {name} < 0, the ray passes beside it"),
+                (None, []) => format!("miss: {name} is not a number"),
+                (None, [a, b]) if *a <= 0.0 && *b <= 0.0 => {
+                    "miss: both roots negative, the sphere is behind the ray".into()
+                }
+                (None, _) => "miss: one root negative, the ray starts inside the sphere \
+                              (the tutorial needs both roots positive)"
+                    .into(),
+            };
+            ObjectTest {
+                object: index,
+                what: format!(
+                    "sphere{role}, centre {}, radius {}",
+                    vector(s.center.to_f64()),
+                    num(s.radius.to_f64())
+                ),
+                discriminant: Some(d),
+                roots,
+                t,
+                verdict,
+            }
+        }
+        Shape::Plane(p) => {
+            let facing = ray.direction.dot(p.normal).to_f64();
+            let crossing = (p.point - ray.origin).dot(p.normal).to_f64() / facing;
+            let verdict = match t {
+                Some(t) => format!("hit at t = {}", num(t)),
+                None if facing == 0.0 => "miss: the ray runs parallel to the plane".into(),
+                None => "miss: the plane is behind the ray".into(),
+            };
+            ObjectTest {
+                object: index,
+                what: format!(
+                    "plane{role}, through {}, normal {}",
+                    vector(p.point.to_f64()),
+                    vector(p.normal.to_f64())
+                ),
+                discriminant: None,
+                roots: if facing == 0.0 {
+                    Vec::new()
+                } else {
+                    vec![crossing]
+                },
+                t,
+                verdict,
+            }
+        }
+    }
+}
+
+fn info<T: Real>(ray: &Ray<T>) -> RayInfo {
+    RayInfo {
+        origin: ray.origin.to_f64().to_array(),
+        direction: ray.direction.to_f64().to_array(),
+    }
+}
+
+fn rules(settings: &Settings) -> String {
+    format!(
+        "precision {}, intersection {}, offset {}, viewer {}, early stop {}, {} sample{} per pixel",
+        settings.precision,
+        settings.method,
+        settings.offset,
+        match settings.viewer {
+            Viewer::Camera => "camera",
+            Viewer::RayOrigin => "ray origin",
+        },
+        if settings.early_stop { "on" } else { "off" },
+        settings.spp,
+        if settings.spp == 1 { "" } else { "s" }
+    )
+}
+
+/// A number for people: 6 significant digits, no trailing zeros.
+pub fn num(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let magnitude = x.abs().log10().floor() as i32;
+    if !(-4..6).contains(&magnitude) {
+        return format!("{x:.5e}");
+    }
+    let decimals = (5 - magnitude).max(0) as usize;
+    let text = format!("{x:.decimals$}");
+    let text = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &text
+    };
+    if text == "-0" {
+        "0".into()
+    } else {
+        text.into()
+    }
+}
+
+fn vector(v: Vec3) -> String {
+    format!("({}, {}, {})", num(v.x), num(v.y), num(v.z))
+}
+
+fn vec3(v: [f64; 3]) -> String {
+    vector(Vec3::from_array(v))
+}
+
+fn byte(v: f64) -> u8 {
+    (v.clamp(0.0, 1.0) as f32 * 255.0).round() as u8
+}
+
+impl std::fmt::Display for Explanation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(
+            f,
+            "pixel x = {}, y = {} (column, row from the top)",
+            self.x, self.y
+        )?;
+        writeln!(f, "stages: {}", self.stages)?;
+        writeln!(f, "rules: {}", self.rules)?;
+        writeln!(f)?;
+        writeln!(f, "primary ray")?;
+        writeln!(f, "  screen point  {}", vec3(self.screen_point))?;
+        writeln!(
+            f,
+            "  origin        {}  (the camera)",
+            vec3(self.primary.origin)
+        )?;
+        writeln!(
+            f,
+            "  direction     {}  (normalize(screen point − camera))",
+            vec3(self.primary.direction)
+        )?;
+        for s in &self.segments {
+            writeln!(f)?;
+            if s.index == 0 {
+                writeln!(f, "segment 0: the primary ray, weight {}", num(s.weight))?;
+            } else {
+                writeln!(
+                    f,
+                    "segment {}: reflection {}, weight {}",
+                    s.index,
+                    s.index,
+                    num(s.weight)
+                )?;
+                writeln!(
+                    f,
+                    "  ray from {} along {}",
+                    vec3(s.ray.origin),
+                    vec3(s.ray.direction)
+                )?;
+            }
+            for t in &s.tests {
+                write!(f, "  object {}: {}", t.object, t.what)?;
+                if let Some(d) = t.discriminant {
+                    write!(f, "; discriminant {}", num(d))?;
+                }
+                if !t.roots.is_empty() {
+                    let roots: Vec<String> = t.roots.iter().map(|&r| num(r)).collect();
+                    write!(f, "; roots {}", roots.join(", "))?;
+                }
+                writeln!(f, "\n    → {}", t.verdict)?;
+            }
+            let Some(h) = &s.hit else {
+                writeln!(f, "  nearest: nothing")?;
+                continue;
+            };
+            writeln!(f, "  nearest: object {} at t = {}", h.object, num(h.t))?;
+            writeln!(f, "  point   {}", vec3(h.point))?;
+            writeln!(f, "  normal  {}", vec3(h.normal))?;
+            writeln!(
+                f,
+                "  moved off the surface by {} to {}",
+                num(h.offset),
+                vec3(h.shifted)
+            )?;
+            match &h.shadow {
+                None => writeln!(f, "  shadow: stage off, the point counts as lit")?,
+                Some(sh) => {
+                    writeln!(
+                        f,
+                        "  shadow ray from the moved point along {}; the light is {} away",
+                        vec3(sh.ray.direction),
+                        num(sh.light_distance)
+                    )?;
+                    match sh.blocker {
+                        None => writeln!(f, "    → nothing in the way: lit")?,
+                        Some((o, t)) if t < sh.light_distance => writeln!(
+                            f,
+                            "    → object {o} at {} < {}: in shadow",
+                            num(t),
+                            num(sh.light_distance)
+                        )?,
+                        Some((o, t)) => writeln!(
+                            f,
+                            "    → object {o} at {}, beyond the light ({}): lit",
+                            num(t),
+                            num(sh.light_distance)
+                        )?,
+                    }
+                }
+            }
+            if let Some(b) = &h.shading {
+                writeln!(
+                    f,
+                    "  Blinn-Phong: L = {}, V = {}",
+                    vec3(b.to_light),
+                    vec3(b.to_viewer)
+                )?;
+                writeln!(
+                    f,
+                    "    L·N = {}, N·H = {}, (N·H)^{} = {}",
+                    num(b.l_dot_n),
+                    num(b.n_dot_h),
+                    num(b.exponent),
+                    num(b.highlight)
+                )?;
+                writeln!(f, "    ambient  ka·la             = {}", vec3(b.ambient))?;
+                writeln!(f, "    diffuse  kd·ld·(L·N)       = {}", vec3(b.diffuse))?;
+                writeln!(
+                    f,
+                    "    specular ks·ls·(N·H)^{:<5} = {}",
+                    num(b.exponent),
+                    vec3(b.specular)
+                )?;
+            }
+            match h.illumination {
+                Some(c) => writeln!(
+                    f,
+                    "  adds {} × weight {}; the sum is now {}",
+                    vec3(c),
+                    num(s.weight),
+                    vec3(h.sum)
+                )?,
+                None => writeln!(f, "  adds nothing (in shadow)")?,
+            }
+        }
+        writeln!(f)?;
+        writeln!(f, "end: {}", self.end)?;
+        writeln!(
+            f,
+            "colour: {} → clipped to [0, 1]: {} → 8-bit ({}, {}, {})",
+            vec3(self.unclipped),
+            vec3(self.colour),
+            byte(self.colour[0]),
+            byte(self.colour[1]),
+            byte(self.colour[2])
+        )?;
+        if let Some(s) = &self.samples {
+            writeln!(
+                f,
+                "with {} samples the pixel is their mean, {}; this story followed the centre ray (the buffers' ray)",
+                s.spp,
+                vec3(s.colour)
+            )?;
+        }
+        writeln!(
+            f,
+            "rays: {} primary, {} shadow, {} reflected",
+            self.rays[0], self.rays[1], self.rays[2]
+        )
+    }
+}
