@@ -115,13 +115,26 @@ impl TileMasks {
                 ];
                 let inside = corners.iter().fold(Vec3::ZERO, |a, &c| a + c);
                 let planes: [Vec3; 4] = std::array::from_fn(|i| {
-                    let n = corners[i].cross(corners[(i + 1) % 4]).normalize();
-                    if n.dot(inside) < 0.0 {
-                        -n
+                    let (a, b) = (corners[i], corners[(i + 1) % 4]);
+                    let n = a.cross(b);
+                    // Edges less than 1e-6 apart in angle (a screen almost without
+                    // height or width) give a plane whose rounding the margin does
+                    // not cover: such a tile gets no plane (NaN), so no mask.
+                    if n.length() >= 1e-6 * a.length() * b.length() {
+                        let n = n.normalize();
+                        if n.dot(inside) < 0.0 {
+                            -n
+                        } else {
+                            n
+                        }
                     } else {
-                        n
+                        Vec3::NAN
                     }
                 });
+                if !planes.iter().all(|n| n.is_finite()) {
+                    masks.push(EVERY);
+                    continue;
+                }
                 // ANCHOR: tile_test
                 let mut mask = 0u64;
                 for (i, sphere) in spheres.iter().enumerate() {

@@ -166,7 +166,9 @@ impl PixelRecord {
             rays: count(rays),
         };
         if let Some(hit) = first {
-            record.depth = hit.depth as f32;
+            // A hit beyond float32's range (a plane met almost edge-on) is stored
+            // as the largest float32: still a hit, not the +∞ of a miss.
+            record.depth = (hit.depth as f32).min(f32::MAX);
             record.normal = hit.normal.as_vec3().to_array();
             record.shadow = if hit.lit { 1.0 } else { 0.0 };
             record.object = count(hit.object as u64);

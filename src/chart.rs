@@ -28,6 +28,7 @@ use crate::accel::Accel;
 use crate::aov::Frame;
 use crate::bench::median;
 use crate::error::Error;
+use crate::output::Pending;
 use crate::real::Precision;
 use crate::render::{render_into, Settings};
 use crate::scene::Scene;
@@ -331,8 +332,10 @@ type DrawSvg<'a> = dyn for<'b> Fn(&DrawingArea<SVGBackend<'b>, Shift>) -> Result
 type DrawBitmap<'a> =
     dyn for<'b> Fn(&DrawingArea<BitMapBackend<'b>, Shift>) -> Result<(), String> + 'a;
 
-/// Write a chart as `stem.svg` and `stem.png` in `dir`, drawn by `draw`.
+/// Write a chart as `stem.svg` and `stem.png` in `dir`, drawn by `draw`, into
+/// `pending` (renamed into place when it is committed).
 fn write_chart(
+    pending: &mut Pending,
     dir: &Path,
     stem: &str,
     draw: &DrawSvg,
@@ -362,11 +365,13 @@ fn write_chart(
             .expect("encoding a PNG into memory cannot fail");
         bytes
     };
-    let files = vec![
+    let files = [
         (dir.join(format!("{stem}.svg")), svg.into_bytes()),
         (dir.join(format!("{stem}.png")), png),
     ];
-    crate::output::write_all_atomically(&files)?;
+    for (path, bytes) in &files {
+        pending.file(path, bytes)?;
+    }
     Ok(files.into_iter().map(|(p, _)| p).collect())
 }
 
@@ -505,12 +510,14 @@ fn draw_sweep<DB: DrawingBackend>(
 
 /// Write the speed-against-accuracy chart as `stem.svg` and `stem.png`.
 pub fn write_sweep(
+    pending: &mut Pending,
     dir: &Path,
     stem: &str,
     points: &[Point],
     title: &str,
 ) -> Result<Vec<std::path::PathBuf>, Error> {
     write_chart(
+        pending,
         dir,
         stem,
         &|root| draw_sweep(root, points, title),
@@ -571,12 +578,14 @@ fn draw_scale<DB: DrawingBackend>(
 
 /// Write the time-against-spheres chart as `stem.svg` and `stem.png`.
 pub fn write_scale(
+    pending: &mut Pending,
     dir: &Path,
     stem: &str,
     points: &[ScalePoint],
     title: &str,
 ) -> Result<Vec<std::path::PathBuf>, Error> {
     write_chart(
+        pending,
         dir,
         stem,
         &|root| draw_scale(root, points, title),
@@ -623,7 +632,9 @@ mod tests {
         let mut points = vec![point("a", 1.0, 2.0), point("b", 2.0, 1.0)];
         points[0].default = true;
         mark_frontier(&mut points);
-        let files = write_sweep(&dir, "t", &points, "test").unwrap();
+        let mut pending = Pending::new();
+        let files = write_sweep(&mut pending, &dir, "t", &points, "test").unwrap();
+        pending.commit().unwrap();
         let svg = std::fs::read_to_string(&files[0]).unwrap();
         assert!(svg.contains("Pareto frontier") && svg.contains("milliseconds per frame"));
         // The two labels, each as its own line of text.

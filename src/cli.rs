@@ -9,6 +9,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use crate::accel::Accel;
 use crate::aov::Frame;
 use crate::error::Error;
+use crate::output::Pending;
 use crate::real::Precision;
 use crate::render::{render, Settings};
 use crate::scene::{Role, Scene, Shape};
@@ -32,12 +33,27 @@ macro_rules! say {
 /// With no command, renders every stage of the built-in figure-1 scene into `out/`
 /// (the same as `raystep stages`).
 #[derive(Parser, Debug)]
-#[command(name = "raystep", version, about, long_about)]
+#[command(name = "raystep", version, about, long_about, after_help = LIMITS)]
 pub struct Cli {
     /// What to do (default: `stages` on the built-in scene).
     #[command(subcommand)]
     pub command: Option<Command>,
 }
+
+/// The limits that keep a mistake from taking the machine down, as `--help` prints
+/// them (the numbers are the constants of [`scene_file`]).
+pub const LIMITS: &str = "\
+Limits (a value beyond them is refused with a message, exit code 2):
+  image          1 to 16384 pixels a side, at most 7680 × 4320 in all: a render
+                 takes about 64 bytes of memory per pixel (2.1 GB at the most)
+  max_depth      1 to 64 segments per path (--max-depth, render.max_depth)
+  --spp          a square number from 1 to 1024
+  numbers        finite, at most 1e15 in magnitude; a radius at least 1e-12 and
+                 1e-6 of the scene's size
+  scene files    at most 16 MiB
+  generate       at most 100,000 spheres
+Exit codes: 0 done, 2 a mistake in the input, 130 interrupted (Ctrl-C: the files
+of the render before stay as they were).";
 
 /// The subcommands.
 #[derive(Subcommand, Debug)]
@@ -173,12 +189,15 @@ pub struct AccuracyArgs {
 /// The scene to render and its size.
 #[derive(Args, Debug, Default)]
 pub struct SceneArgs {
-    /// Scene file (TOML). Default: the built-in figure-1 scene (scenes/seed.toml).
+    /// Scene file (TOML, at most 16 MiB). Default: the built-in figure-1 scene
+    /// (scenes/seed.toml).
     pub scene: Option<PathBuf>,
-    /// Image width in pixels (overrides the scene's [image] width; 1 to 16384).
+    /// Image width in pixels (overrides the scene's [image] width; 1 to 16384, and
+    /// at most 7680 × 4320 pixels in all: about 64 bytes of memory each).
     #[arg(long)]
     pub width: Option<u32>,
-    /// Image height in pixels (overrides the scene's [image] height; 1 to 16384).
+    /// Image height in pixels (overrides the scene's [image] height; 1 to 16384, and
+    /// at most 7680 × 4320 pixels in all).
     #[arg(long)]
     pub height: Option<u32>,
 }
@@ -403,7 +422,18 @@ pub fn load_scene(args: &SceneArgs) -> Result<(Scene, String), Error> {
         Some(path) => scene_file::load_sized(path, size)?,
         None => scene_file::parse_sized(scene_file::SEED_TOML, scene_file::SEED_NAME, size)?,
     };
+    warn_if_empty(&scene, &scene_name(args));
     Ok((scene, scene_name(args)))
+}
+
+/// A scene without objects is valid, but almost surely not what was meant.
+fn warn_if_empty(scene: &Scene, name: &str) {
+    if scene.objects.is_empty() {
+        eprintln!(
+            "warning: {name}: the scene has no [[sphere]] and no [[plane]], so every ray \
+             misses and the image is black"
+        );
+    }
 }
 
 /// The contact sheet `raystep stages` writes: a row per stage, a column per buffer.
@@ -412,7 +442,10 @@ pub const CONTACT_SHEET: &str = "contact-sheet.png";
 fn stages(args: StagesArgs) -> Result<(), Error> {
     let (mut scene, name) = load_scene(&args.scene)?;
     let base = args.rules.apply(&mut scene, Stages::ALL)?;
-    ensure_folder(&args.out)?;
+    // Every file of every stage is renamed into place at the end, together: an
+    // error or Ctrl-C on the way leaves the folder as it was.
+    let mut pending = Pending::new();
+    pending.folder(&args.out)?;
     say!("{name}: every stage at {} × {}", scene.width, scene.height);
     let bar = progress_bar(u64::from(scene.height) * Stage::ALL.len() as u64);
     let start = Instant::now();
@@ -426,9 +459,15 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
             ..base
         };
         let (frame, seconds) = timed(|| render(&scene, &settings, &|n| bar.inc(n)));
-        write(&frame, &dir, seconds, &bar)?;
-        // The numbers behind the pictures, for the page.
-        crate::page::write_pixels(&dir, &stage.folder(), &frame)?;
+        crate::interrupt::check()?;
+        pending.folder(&dir)?;
+        write(&mut pending, &frame, &dir, seconds, &bar)?;
+        // The numbers behind the pictures, for the page (up to a size).
+        if crate::page::has_numbers(scene.width, scene.height) {
+            crate::page::write_pixels(&mut pending, &dir, &stage.folder(), &frame)?;
+        } else {
+            pending.remove_on_commit(&dir.join(crate::page::PIXELS_FILE));
+        }
         let label = stage.label();
         sheet.add_row(&label, &frame);
         page.push(crate::page::PageStage {
@@ -441,8 +480,16 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
     }
     bar.finish_and_clear();
     let contact = args.out.join(CONTACT_SHEET);
-    crate::output::write_atomically(&contact, &sheet.png())?;
-    let index = crate::page::write_index(&args.out, &name, scene.width, scene.height, &page)?;
+    pending.file(&contact, &sheet.png())?;
+    let index = crate::page::write_index(
+        &mut pending,
+        &args.out,
+        &name,
+        scene.width,
+        scene.height,
+        &page,
+    )?;
+    pending.commit()?;
     say!(
         "wrote {} stages into {}/ in {:.2} s",
         Stage::ALL.len(),
@@ -487,7 +534,8 @@ fn explain(args: &ExplainArgs) -> Result<(), Error> {
 
 fn render_one(args: RenderArgs) -> Result<(), Error> {
     let (scene, settings) = prepare(&args.frame)?;
-    ensure_folder(&args.out)?;
+    let mut pending = Pending::new();
+    pending.folder(&args.out)?;
     let name = scene_name(&args.frame.scene);
     say!(
         "{name}: {} at {} × {}",
@@ -498,11 +546,20 @@ fn render_one(args: RenderArgs) -> Result<(), Error> {
     let bar = progress_bar(u64::from(scene.height));
     let (frame, seconds) = timed(|| render(&scene, &settings, &|n| bar.inc(n)));
     bar.finish_and_clear();
-    write(&frame, &args.out, seconds, &bar)
+    crate::interrupt::check()?;
+    write(&mut pending, &frame, &args.out, seconds, &bar)?;
+    pending.commit()
 }
 
-fn write(frame: &Frame, dir: &Path, render_seconds: f64, bar: &ProgressBar) -> Result<(), Error> {
-    let (written, write_seconds) = timed(|| crate::output::write_frame(frame, dir));
+/// Write the files of `frame` into `pending` and say which, with the times.
+fn write(
+    pending: &mut Pending,
+    frame: &Frame,
+    dir: &Path,
+    render_seconds: f64,
+    bar: &ProgressBar,
+) -> Result<(), Error> {
+    let (written, write_seconds) = timed(|| pending.frame(frame, dir));
     let names: Vec<String> = written?
         .iter()
         .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
@@ -537,6 +594,7 @@ fn bench(mut args: BenchArgs) -> Result<(), Error> {
     let bar = counted_bar(u64::from(args.runs) + 1, "bench", "runs");
     let report = crate::bench::bench(&scene, &settings, options, &|n| bar.inc(n))?;
     bar.finish_and_clear();
+    crate::interrupt::check()?;
     if args.json {
         let json = serde_json::to_string(&report).expect("a report is always valid JSON");
         say!("{json}");
@@ -547,7 +605,8 @@ fn bench(mut args: BenchArgs) -> Result<(), Error> {
 }
 
 fn chart(mut args: ChartArgs) -> Result<(), Error> {
-    ensure_folder(&args.out)?;
+    let mut pending = Pending::new();
+    pending.folder(&args.out)?;
     let runs = args.runs as usize;
     if args.scale && args.scene.scene.is_some() {
         return Err(Error::Usage(
@@ -579,10 +638,12 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
         let bar = counted_bar(renders, "scale", "renders");
         let points = crate::chart::scale(&counts, plain_up_to, size, runs, &|n| bar.inc(n));
         bar.finish_and_clear();
+        crate::interrupt::check()?;
         let csv = crate::chart::scale_csv(&points);
-        crate::output::write_atomically(&args.out.join("scale.csv"), csv.as_bytes())?;
+        pending.file(&args.out.join("scale.csv"), csv.as_bytes())?;
         let title = format!("Time against spheres, {} × {}, every stage", size.0, size.1);
-        let files = crate::chart::write_scale(&args.out, "scale", &points, &title)?;
+        let files = crate::chart::write_scale(&mut pending, &args.out, "scale", &points, &title)?;
+        pending.commit()?;
         say!("{}", csv.trim_end());
         say!("wrote {}/scale.csv, {}", args.out.display(), names(&files));
         return Ok(());
@@ -597,13 +658,15 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
     let bar = counted_bar(crate::chart::sweep_renders(runs), "chart", "renders");
     let points = crate::chart::sweep(&scene, runs, &|n| bar.inc(n));
     bar.finish_and_clear();
+    crate::interrupt::check()?;
     let csv = crate::chart::csv(&points);
-    crate::output::write_atomically(&args.out.join("chart.csv"), csv.as_bytes())?;
+    pending.file(&args.out.join("chart.csv"), csv.as_bytes())?;
     let title = format!(
         "Speed against accuracy: {name}, {} × {}",
         scene.width, scene.height
     );
-    let files = crate::chart::write_sweep(&args.out, "chart", &points, &title)?;
+    let files = crate::chart::write_sweep(&mut pending, &args.out, "chart", &points, &title)?;
+    pending.commit()?;
     say!("{}", csv.trim_end());
     say!("wrote {}/chart.csv, {}", args.out.display(), names(&files));
     Ok(())
@@ -639,19 +702,6 @@ fn counted_bar(len: u64, label: &str, unit: &str) -> ProgressBar {
             .progress_chars("=> "),
     );
     bar
-}
-
-fn ensure_folder(dir: &Path) -> Result<(), Error> {
-    if dir.exists() && !dir.is_dir() {
-        return Err(Error::Output {
-            path: dir.to_path_buf(),
-            message: "it is a file, not a folder; give --out a folder".into(),
-        });
-    }
-    std::fs::create_dir_all(dir).map_err(|e| Error::Output {
-        path: dir.to_path_buf(),
-        message: format!("cannot create the output folder: {e}"),
-    })
 }
 
 fn diff(args: &DiffArgs) -> Result<(), Error> {
@@ -747,6 +797,7 @@ fn figures(args: &FiguresArgs) -> Result<(), Error> {
 
 fn check(path: &Path) -> Result<(), Error> {
     let scene = scene_file::load(path)?;
+    warn_if_empty(&scene, &path.display().to_string());
     say!(
         "{}",
         describe(&scene, &path.display().to_string()).trim_end()

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use crate::error::Error;
+use crate::scene_file::MAX_PIXELS;
 
 /// How two images of the same size differ.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,38 +52,51 @@ pub fn compare(a: &[[f32; 3]], b: &[[f32; 3]], width: usize) -> Difference {
 }
 
 /// The beauty (`R`, `G`, `B`) of a `buffers.exr` file: width, height, pixels.
+///
+/// The header is read first, and an image larger than raystep renders is refused
+/// before any memory is taken for its pixels (a damaged or hostile header can claim
+/// any size). Only the three colour channels are read.
 pub fn read_beauty(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>), Error> {
     let fail = |message: String| Error::Scene {
         file: path.display().to_string(),
         message,
     };
-    let image = exr::prelude::read_all_flat_layers_from_file(path)
-        .map_err(|e| fail(format!("cannot read it as an EXR file: {e}")))?;
-    let layer = image
-        .layer_data
-        .first()
-        .ok_or_else(|| fail("has no image layer".into()))?;
-    let channel = |name: &str| {
-        layer
-            .channel_data
-            .list
-            .iter()
-            .find(|c| c.name == *name)
-            .map(|c| c.sample_data.values_as_f32().collect::<Vec<f32>>())
-            .ok_or_else(|| {
-                fail(format!(
-                    "has no `{name}` channel; raystep's buffers.exr has R, G, B"
-                ))
-            })
-    };
-    let (r, g, b) = (channel("R")?, channel("G")?, channel("B")?);
-    let pixels = r
+    let not_exr = |e: exr::error::Error| fail(format!("cannot read it as an EXR file: {e}"));
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(not_exr)?;
+    let largest = meta
+        .headers
         .iter()
-        .zip(&g)
-        .zip(&b)
-        .map(|((&r, &g), &b)| [r, g, b])
-        .collect();
-    Ok((layer.size.0, layer.size.1, pixels))
+        .map(|h| h.layer_size.area() as u64)
+        .max()
+        .ok_or_else(|| fail("has no image layer".into()))?;
+    if largest > MAX_PIXELS {
+        return Err(fail(format!(
+            "holds an image of {largest} pixels; raystep compares at most {MAX_PIXELS}, \
+             the most it renders"
+        )));
+    }
+    use exr::prelude::{ReadChannels as _, ReadLayers as _};
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgb_channels(
+            |size, _| (size.width(), vec![[0.0f32; 3]; size.area()]),
+            |(width, pixels): &mut (usize, Vec<[f32; 3]>), at, (r, g, b): (f32, f32, f32)| {
+                pixels[at.y() * *width + at.x()] = [r, g, b];
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| match e {
+            exr::error::Error::Invalid(message) if message.contains("channel") => fail(format!(
+                "has no R, G and B channels ({message}); raystep's buffers.exr has them"
+            )),
+            e => not_exr(e),
+        })?;
+    let size = image.layer_data.size;
+    let (_, pixels) = image.layer_data.channel_data.pixels;
+    Ok((size.width(), size.height(), pixels))
 }
 
 #[cfg(test)]

@@ -26,6 +26,18 @@ pub enum Error {
         /// Why.
         message: String,
     },
+    /// Ctrl-C (or SIGTERM) arrived before the files were renamed into place.
+    Interrupted,
+}
+
+impl Error {
+    /// The exit code: [`USER_ERROR`] for a mistake, 130 after an interrupt.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Error::Interrupted => crate::interrupt::EXIT_CODE,
+            _ => USER_ERROR as u8,
+        }
+    }
 }
 
 impl fmt::Display for Error {
@@ -36,6 +48,10 @@ impl fmt::Display for Error {
             Error::Output { path, message } => {
                 write!(f, "cannot write {}: {message}", path.display())
             }
+            Error::Interrupted => f.write_str(
+                "interrupted: nothing was written, and the files of the render before \
+                 are as they were",
+            ),
         }
     }
 }

@@ -55,4 +55,5 @@ pub mod error;
 pub mod explain;
 pub mod figures;
 pub mod generate;
+pub mod interrupt;
 pub mod yardstick;

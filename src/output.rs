@@ -1,7 +1,7 @@
 //! Buffers to files: PNG pictures for eyes, one EXR file with the raw floats.
 //!
-//! Every file is written under a temporary name and then renamed, so a reader (or
-//! an interrupted render) never sees a half-written image.
+//! Every file is written under a temporary name and then renamed ([`Pending`]), so
+//! a reader (or an interrupted render) never sees a half-written image.
 
 use std::fs;
 use std::io::{BufWriter, Cursor, Seek, Write};
@@ -21,101 +21,22 @@ use crate::error::Error;
 pub const EXR_FILE: &str = "buffers.exr";
 
 /// Write `frame` into the folder `dir` (created if needed): one PNG per buffer and
-/// [`EXR_FILE`]. All of them are written to temporary names before any is renamed
-/// into place, and buffer files of an earlier render that this frame does not have
-/// (say `depth.png` after a `rays`-only render) are removed. A write that fails
-/// leaves the earlier render's files as they were. Returns the files written.
-///
-/// The EXR file is streamed from the frame to its file, scan line by scan line,
-/// so no copy of the buffers is made: at 1920 × 1080 the frame's 100 MB is most of
-/// what the whole render holds in memory.
+/// [`EXR_FILE`], committed together (see [`Pending`]). Returns the files written.
 pub fn write_frame(frame: &Frame, dir: &Path) -> Result<Vec<PathBuf>, Error> {
-    fs::create_dir_all(dir).map_err(|e| Error::Output {
-        path: dir.to_path_buf(),
-        message: format!("cannot create the output folder: {e}"),
-    })?;
-    let buffers: Vec<Buffer> = frame.buffers().collect();
-    let mut paths: Vec<PathBuf> = buffers
-        .iter()
-        .map(|b| dir.join(format!("{}.png", b.name())))
-        .collect();
-    paths.push(dir.join(EXR_FILE));
-    let temporaries: Vec<PathBuf> = paths.iter().map(|p| temporary_name(p)).collect();
-    let fail = |path: &Path, message: String| Error::Output {
-        path: path.to_path_buf(),
-        message,
-    };
-    // Encode and write every file in parallel (each encoder is deterministic).
-    let (pngs, exr) = rayon::join(
-        || {
-            buffers
-                .par_iter()
-                .zip(&paths)
-                .zip(&temporaries)
-                .map(|((&b, path), temporary)| {
-                    fs::write(temporary, png_bytes(frame, b)).map_err(|e| fail(path, e.to_string()))
-                })
-                .collect::<Result<Vec<()>, Error>>()
-        },
-        || write_exr(frame, &temporaries[buffers.len()], &paths[buffers.len()]),
-    );
-    if let Err(e) = pngs.and(exr) {
-        remove_all(&temporaries);
-        return Err(e);
-    }
-    rename_all(&temporaries, &paths)?;
-    for buffer in Buffer::ALL.into_iter().filter(|&b| !frame.has(b)) {
-        let stale = dir.join(format!("{}.png", buffer.name()));
-        if stale.is_file() {
-            fs::remove_file(&stale).map_err(|e| Error::Output {
-                path: stale.clone(),
-                message: format!("cannot remove the stale buffer of an earlier render: {e}"),
-            })?;
-        }
-    }
+    let mut pending = Pending::new();
+    pending.folder(dir)?;
+    let paths = pending.frame(frame, dir)?;
+    pending.commit()?;
     Ok(paths)
 }
 
-/// Remove the temporary files of a write that failed (those already renamed, or
-/// never made, are simply not there).
-fn remove_all(temporaries: &[PathBuf]) {
-    for t in temporaries {
-        let _ = fs::remove_file(t);
-    }
-}
-
-/// Rename each complete temporary file onto its path. A failure removes the
-/// temporary files left (a failure among the renames, which do not fail on a
-/// working disk, may leave some files renamed).
-fn rename_all(temporaries: &[PathBuf], paths: &[PathBuf]) -> Result<(), Error> {
-    for (temporary, path) in temporaries.iter().zip(paths) {
-        if let Err(e) = fs::rename(temporary, path) {
-            remove_all(temporaries);
-            return Err(Error::Output {
-                path: path.clone(),
-                message: e.to_string(),
-            });
-        }
-    }
-    Ok(())
-}
-
-/// Write several files: every one to a temporary name in its folder first, and only
-/// when all are complete, rename them into place. A failure removes the temporary
-/// files and leaves the old ones as they were.
+/// Write several files, all or none (see [`Pending`]).
 pub fn write_all_atomically(files: &[(PathBuf, Vec<u8>)]) -> Result<(), Error> {
-    let paths: Vec<PathBuf> = files.iter().map(|(path, _)| path.clone()).collect();
-    let temporaries: Vec<PathBuf> = paths.iter().map(|p| temporary_name(p)).collect();
-    for ((path, bytes), temporary) in files.iter().zip(&temporaries) {
-        if let Err(e) = fs::write(temporary, bytes) {
-            remove_all(&temporaries);
-            return Err(Error::Output {
-                path: path.clone(),
-                message: e.to_string(),
-            });
-        }
+    let mut pending = Pending::new();
+    for (path, bytes) in files {
+        pending.file(path, bytes)?;
     }
-    rename_all(&temporaries, &paths)
+    pending.commit()
 }
 
 /// Write `bytes` to `path` through a temporary file in the same folder, renamed
@@ -124,12 +45,213 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     write_all_atomically(&[(path.to_path_buf(), bytes.to_vec())])
 }
 
+/// Output files written under temporary names, waiting to be renamed into place
+/// together by [`Pending::commit`].
+///
+/// Until the commit, no file a reader (or an earlier render) owns is touched: each
+/// file is first written in full beside its final name, as
+/// `.NAME.PID.raystep.tmp`. The commit renames them all (and removes the buffer
+/// files of an earlier render that this one does not have), which takes a few
+/// milliseconds even for `raystep stages`. Dropped without a commit (after an
+/// error, or Ctrl-C, which [`Pending::commit`] checks for), it removes its
+/// temporary files and the folders it created, so the output folder holds what it
+/// held before. A killed process cannot clean up: the next write into the same
+/// folder removes the temporary files whose process is gone.
+#[derive(Debug, Default)]
+pub struct Pending {
+    /// (temporary, final) paths, in the order written.
+    files: Vec<(PathBuf, PathBuf)>,
+    /// Files of an earlier render that the commit removes.
+    stale: Vec<PathBuf>,
+    /// Folders created for this write, outermost first.
+    created: Vec<PathBuf>,
+}
+
+impl Pending {
+    /// Nothing written yet.
+    pub fn new() -> Pending {
+        Pending::default()
+    }
+
+    /// Make sure `dir` is a folder that files can be written in: create it (and
+    /// the folders above it) if needed, and try a file in it, so that a folder
+    /// that cannot be written fails now, not after a long render. Temporary files
+    /// that a killed raystep left in it are removed.
+    pub fn folder(&mut self, dir: &Path) -> Result<(), Error> {
+        let fail = |message: String| Error::Output {
+            path: dir.to_path_buf(),
+            message,
+        };
+        if dir.exists() && !dir.is_dir() {
+            return Err(fail(
+                "it is a file, not a folder; give --out a folder".into(),
+            ));
+        }
+        let missing: Vec<&Path> = dir
+            .ancestors()
+            .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+            .collect();
+        for folder in missing.into_iter().rev() {
+            match fs::create_dir(folder) {
+                Ok(()) => self.created.push(folder.to_path_buf()),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && folder.is_dir() => {}
+                Err(e) => return Err(fail(format!("cannot create the output folder: {e}"))),
+            }
+        }
+        let probe = temporary_name(&dir.join("probe"));
+        fs::write(&probe, b"")
+            .and_then(|()| fs::remove_file(&probe))
+            .map_err(|e| fail(format!("cannot write files in the output folder: {e}")))?;
+        remove_abandoned_temporaries(dir);
+        Ok(())
+    }
+
+    /// Write `bytes` to a temporary name beside `path`.
+    pub fn file(&mut self, path: &Path, bytes: &[u8]) -> Result<(), Error> {
+        let temporary = self.register(path);
+        fs::write(&temporary, bytes).map_err(|e| Error::Output {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Write the files of `frame` into `dir` (a [`Pending::folder`]): one PNG per
+    /// buffer and [`EXR_FILE`], encoded in parallel. Buffer files of an earlier
+    /// render that this frame does not have (say `depth.png` after a `rays`-only
+    /// render) will be removed by the commit. Returns the files' final paths.
+    ///
+    /// The EXR file is streamed from the frame to its file, scan line by scan
+    /// line, so no copy of the buffers is made: at 1920 × 1080 the frame's 100 MB
+    /// is most of what the whole render holds in memory.
+    pub fn frame(&mut self, frame: &Frame, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+        let buffers: Vec<Buffer> = frame.buffers().collect();
+        let mut paths: Vec<PathBuf> = buffers
+            .iter()
+            .map(|b| dir.join(format!("{}.png", b.name())))
+            .collect();
+        paths.push(dir.join(EXR_FILE));
+        let temporaries: Vec<PathBuf> = paths.iter().map(|p| self.register(p)).collect();
+        let fail = |path: &Path, message: String| Error::Output {
+            path: path.to_path_buf(),
+            message,
+        };
+        // Encode and write every file in parallel (each encoder is deterministic).
+        let (pngs, exr) = rayon::join(
+            || {
+                buffers
+                    .par_iter()
+                    .zip(&paths)
+                    .zip(&temporaries)
+                    .map(|((&b, path), temporary)| {
+                        fs::write(temporary, png_bytes(frame, b))
+                            .map_err(|e| fail(path, e.to_string()))
+                    })
+                    .collect::<Result<Vec<()>, Error>>()
+            },
+            || write_exr(frame, &temporaries[buffers.len()], &paths[buffers.len()]),
+        );
+        pngs.and(exr)?;
+        self.stale.extend(
+            Buffer::ALL
+                .into_iter()
+                .filter(|&b| !frame.has(b))
+                .map(|b| dir.join(format!("{}.png", b.name()))),
+        );
+        Ok(paths)
+    }
+
+    /// Remove `path`, a file of an earlier run that this one does not write, when
+    /// the rest is committed.
+    pub fn remove_on_commit(&mut self, path: &Path) {
+        self.stale.push(path.to_path_buf());
+    }
+
+    /// Rename every file into place, then remove the stale ones; refused with
+    /// [`Error::Interrupted`] (and everything removed) after Ctrl-C.
+    pub fn commit(mut self) -> Result<(), Error> {
+        crate::interrupt::check()?;
+        let files = std::mem::take(&mut self.files);
+        for (i, (temporary, path)) in files.iter().enumerate() {
+            if let Err(e) = fs::rename(temporary, path) {
+                // Renames do not fail on a working disk; those done stay done.
+                self.files = files[i..].to_vec();
+                return Err(Error::Output {
+                    path: path.clone(),
+                    message: e.to_string(),
+                });
+            }
+        }
+        self.created.clear();
+        for stale in std::mem::take(&mut self.stale) {
+            if stale.is_file() {
+                fs::remove_file(&stale).map_err(|e| Error::Output {
+                    path: stale.clone(),
+                    message: format!("cannot remove this file of an earlier render: {e}"),
+                })?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Note that `path` is being written, and return its temporary name.
+    fn register(&mut self, path: &Path) -> PathBuf {
+        let temporary = temporary_name(path);
+        self.files.push((temporary.clone(), path.to_path_buf()));
+        temporary
+    }
+}
+
+impl Drop for Pending {
+    /// Not committed: remove the temporary files, then the folders created for
+    /// them if they are empty (`remove_dir` refuses a folder that is not).
+    fn drop(&mut self) {
+        for (temporary, _) in &self.files {
+            let _ = fs::remove_file(temporary);
+        }
+        for folder in self.created.iter().rev() {
+            let _ = fs::remove_dir(folder);
+        }
+    }
+}
+
+/// The suffix of every temporary file raystep writes.
+const TEMPORARY_SUFFIX: &str = ".raystep.tmp";
+
+/// `dir/.NAME.PID.raystep.tmp` for `dir/NAME`: hidden, beside its final name (so
+/// the rename stays on one file system), and naming the process that writes it.
 fn temporary_name(path: &Path) -> PathBuf {
     let name = path
         .file_name()
         .and_then(|n| n.to_str())
         .unwrap_or("output");
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+    path.with_file_name(format!(".{name}.{}{TEMPORARY_SUFFIX}", std::process::id()))
+}
+
+/// Remove the temporary files in `dir` that a raystep process which no longer
+/// runs left behind (it was killed before it could clean up). Only on Linux, where
+/// `/proc` tells whether a process runs; elsewhere they stay, harmless and hidden.
+fn remove_abandoned_temporaries(dir: &Path) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else { continue };
+        let Some(pid) = name
+            .strip_prefix('.')
+            .and_then(|n| n.strip_suffix(TEMPORARY_SUFFIX))
+            .and_then(|n| n.rsplit_once('.'))
+            .and_then(|(_, pid)| pid.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = fs::remove_file(entry.path());
+        }
+    }
 }
 
 // ANCHOR: visualise

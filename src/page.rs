@@ -20,13 +20,23 @@ use serde::Serialize;
 
 use crate::aov::{Buffer, Frame, PixelRecord, NO_OBJECT};
 use crate::error::Error;
-use crate::output::{write_all_atomically, write_atomically};
+use crate::output::Pending;
 
 /// The page's file, in the folder of `raystep stages`.
 pub const INDEX_FILE: &str = "index.html";
 
 /// The numbers of a stage, in the stage's folder.
 pub const PIXELS_FILE: &str = "pixels.js";
+
+/// The largest render whose numbers [`PIXELS_FILE`] holds: 1920 × 1080. Its
+/// file takes 59 bytes per pixel (122 MB at this size, per stage); above it the
+/// page still shows the pictures, and says where to read the numbers instead.
+pub const NUMBERS_UP_TO: u64 = 1920 * 1080;
+
+/// Whether a render of `width` × `height` gets a [`PIXELS_FILE`].
+pub fn has_numbers(width: u32, height: u32) -> bool {
+    u64::from(width) * u64::from(height) <= NUMBERS_UP_TO
+}
 
 /// The floats of each pixel in [`PIXELS_FILE`], in order.
 pub const FIELDS: [&str; 11] = [
@@ -122,6 +132,8 @@ pub fn index_html(scene_name: &str, width: u32, height: u32, stages: &[PageStage
         "height": height,
         "buffers": columns(stages),
         "stages": stages,
+        "numbers": has_numbers(width, height),
+        "numbersUpTo": NUMBERS_UP_TO,
     });
     // `<` written as `\u003c` (the same string to JavaScript) so that no text in
     // the manifest, say a scene named `</script>`, can end the <script> element.
@@ -152,15 +164,19 @@ fn columns(stages: &[PageStage]) -> Vec<String> {
     columns
 }
 
-/// Write `dir/pixels.js` for the frame of the stage in `folder`.
-pub fn write_pixels(dir: &Path, folder: &str, frame: &Frame) -> Result<(), Error> {
-    // Owned bytes, not copied again: at 1920 × 1080 the file is 122 MB.
-    let js = pixels_js(folder, frame).into_bytes();
-    write_all_atomically(&[(dir.join(PIXELS_FILE), js)])
+/// Write `dir/pixels.js` for the frame of the stage in `folder`, into `pending`.
+pub fn write_pixels(
+    pending: &mut Pending,
+    dir: &Path,
+    folder: &str,
+    frame: &Frame,
+) -> Result<(), Error> {
+    pending.file(&dir.join(PIXELS_FILE), pixels_js(folder, frame).as_bytes())
 }
 
-/// Write `out/index.html`; returns its path.
+/// Write `out/index.html` into `pending`; returns its path.
 pub fn write_index(
+    pending: &mut Pending,
     out: &Path,
     scene_name: &str,
     width: u32,
@@ -168,7 +184,7 @@ pub fn write_index(
     stages: &[PageStage],
 ) -> Result<PathBuf, Error> {
     let path = out.join(INDEX_FILE);
-    write_atomically(
+    pending.file(
         &path,
         index_html(scene_name, width, height, stages).as_bytes(),
     )?;
@@ -280,5 +296,13 @@ mod tests {
         assert_eq!(manifest["stages"][0]["folder"], "01-rays");
         assert!(html.contains("image-rendering: pixelated"), "the CSS is in");
         assert!(html.contains("window.raystepPixels"), "the script is in");
+        assert_eq!(manifest["numbers"], true);
+        // Past 1920 × 1080 the page has no numbers, and says so.
+        let big = index_html("big", 1921, 1080, &stages);
+        assert!(
+            big.contains(r#""numbers":false"#),
+            "no numbers at 1921 × 1080"
+        );
+        assert!(has_numbers(1920, 1080) && !has_numbers(1080, 1921));
     }
 }

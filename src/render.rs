@@ -245,7 +245,8 @@ impl<T: Real> Tracer<T> {
     pub fn pixel(&self, row: u32, col: u32) -> (PixelRecord, Rays) {
         let ray = self.camera.primary_ray::<T>(row, col);
         if !self.stages.intersection {
-            let colour = (ray.direction.to_f64() + Vec3::ONE) * 0.5;
+            // Clipped like every colour: rounding can leave a component just past ±1.
+            let colour = ((ray.direction.to_f64() + Vec3::ONE) * 0.5).clamp(Vec3::ZERO, Vec3::ONE);
             let rays = Rays {
                 primary: 1,
                 ..Rays::default()
@@ -505,6 +506,9 @@ fn render_in<T: Real>(
         .enumerate()
         .map(|(row, line)| {
             let mut rays = Rays::default();
+            if crate::interrupt::requested() {
+                return rays; // Ctrl-C: the rest is skipped, and the frame thrown away
+            }
             for (col, pixel) in line.iter_mut().enumerate() {
                 let (record, taken) = tracer.pixel(row as u32, col as u32);
                 *pixel = record;

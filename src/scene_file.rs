@@ -26,17 +26,25 @@ pub const SEED_NAME: &str = "scenes/seed.toml (built in)";
 pub const MAX_SIDE: u32 = 16384;
 
 /// Largest accepted image, in pixels: 7680 × 4320 (8K). A render peaks at about
-/// [`PEAK_BYTES_PER_PIXEL`], so this one needs about 4 GB.
+/// [`PEAK_BYTES_PER_PIXEL`], so this one needs about 2.1 GB of memory (and writes
+/// 1.7 GB of files per stage).
 pub const MAX_PIXELS: u64 = 7680 * 4320;
 
-/// Peak memory of a render and its files per pixel, measured: an 8000 × 6000
-/// render peaked at 5.6 GB resident (`/usr/bin/time -v raystep render --width 8000
-/// --height 6000`).
-pub const PEAK_BYTES_PER_PIXEL: u64 = 120;
+/// Peak memory of a render and its files per pixel, rounded up from measurements:
+/// `/usr/bin/time -f %M raystep render --width 7680 --height 4320` peaked at
+/// 1.91 GB (58 bytes per pixel), and `raystep stages` at that size at 1.94 GB.
+pub const PEAK_BYTES_PER_PIXEL: u64 = 64;
 
 /// Largest magnitude accepted for any number in a scene: squares of coordinates
 /// stay far inside float32's and float64's range.
 pub const MAX_MAGNITUDE: f64 = 1e15;
+
+/// Smallest accepted radius of a sphere.
+pub const MIN_RADIUS: f64 = 1e-12;
+
+/// Smallest accepted radius of a sphere, as a fraction of the largest coordinate
+/// of its center and of the camera (float32 rounds a coordinate by 6e-8 of it).
+pub const MIN_RADIUS_RATIO: f64 = 1e-6;
 
 /// Largest accepted `max_depth`.
 pub const MAX_DEPTH: u32 = 64;
@@ -108,14 +116,186 @@ pub fn parse_sized(text: &str, file: &str, size: SizeOverride) -> Result<Scene, 
         file: file.to_string(),
         message,
     };
-    let raw: SceneFile =
-        toml::from_str(text).map_err(|e| fail(e.to_string().trim_end().to_string()))?;
+    // Editors on Windows may start a UTF-8 file with a byte-order mark.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    if text
+        .lines()
+        .all(|l| l.trim().is_empty() || l.trim_start().starts_with('#'))
+    {
+        return Err(fail(format!(
+            "is empty{}; a scene needs at least a camera and a light:\n{SMALLEST_SCENE}",
+            if text.trim().is_empty() {
+                ""
+            } else {
+                " (only comments)"
+            }
+        )));
+    }
+    let raw: SceneFile = toml::from_str(text).map_err(|e| fail(toml_error(&e, text)))?;
     raw.check(size)
         .map_err(|message| match (size.width, size.height) {
             (None, None) => fail(message),
             _ if message.starts_with("--") => Error::Usage(message),
             _ => fail(message),
         })
+}
+
+/// The smallest scene raystep accepts, shown when a file lacks its camera or light.
+const SMALLEST_SCENE: &str =
+    "    [camera]\n    position = [0, 0, 1]\n    [light]\n    position = [5, 5, 5]";
+
+/// Every section of a scene file and its keys, for "did you mean" and "belongs in".
+const SECTIONS: [(&str, &[&str]); 7] = [
+    ("[image]", &["width", "height"]),
+    ("[camera]", &["position"]),
+    ("[screen]", &["left", "right", "top", "bottom"]),
+    ("[light]", &["position", "ambient", "diffuse", "specular"]),
+    ("[render]", &["max_depth"]),
+    (
+        "[[sphere]]",
+        &[
+            "center",
+            "radius",
+            "ambient",
+            "diffuse",
+            "specular",
+            "shininess",
+            "reflection",
+        ],
+    ),
+    (
+        "[[plane]]",
+        &[
+            "sphere",
+            "point",
+            "normal",
+            "ambient",
+            "diffuse",
+            "specular",
+            "shininess",
+            "reflection",
+        ],
+    ),
+];
+
+/// A TOML or schema error as a message: where (line and column), what, a hint when
+/// one is known, and the line itself with a mark under the place, cut to 80
+/// characters around it (a file may be one huge line).
+fn toml_error(e: &toml::de::Error, text: &str) -> String {
+    let what = plain_types(e.message().trim_end());
+    let Some(span) = e.span() else {
+        let hint = hint(&what).map(|h| format!("; {h}")).unwrap_or_default();
+        return format!("{what}{hint}");
+    };
+    let start = span.start.min(text.len());
+    let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
+    let line_end = text[start..].find('\n').map_or(text.len(), |i| start + i);
+    let (what, hint) = match brackets(&what, &text[line_start..line_end]) {
+        Some(instead) => (instead, String::new()),
+        None => {
+            let hint = hint(&what).map(|h| format!("; {h}")).unwrap_or_default();
+            (what, hint)
+        }
+    };
+    let line = text[..start].matches('\n').count() + 1;
+    let chars: Vec<char> = text[line_start..line_end]
+        .trim_end_matches('\r')
+        .chars()
+        .collect();
+    let column = text[line_start..start].chars().count();
+    let width = text[start..span.end.clamp(start, line_end)]
+        .chars()
+        .count()
+        .max(1);
+    // A window of at most 80 characters that shows the column.
+    let from = column
+        .saturating_sub(40)
+        .min(chars.len().saturating_sub(80));
+    let to = chars.len().min(from + 80);
+    let shown: String = chars[from..to].iter().collect();
+    let (dots_before, dots_after) = (
+        if from > 0 { "…" } else { "" },
+        if to < chars.len() { "…" } else { "" },
+    );
+    let gutter = " ".repeat(line.to_string().len());
+    let pad = " ".repeat(column - from + dots_before.chars().count());
+    let marks = "^".repeat(width.min(to.saturating_sub(column)).max(1));
+    format!(
+        "line {line}, column {}: {what}{hint}\n{gutter} |\n{line} | {dots_before}{shown}{dots_after}\n{gutter} | {pad}{marks}",
+        column + 1
+    )
+}
+
+/// serde's names of types, in words a scene's author uses.
+fn plain_types(message: &str) -> String {
+    let message = match message.split_once("expected struct ") {
+        // `expected struct CameraKeys`: the name is raystep's, not the file's.
+        Some((before, _)) => format!("{before}expected a table"),
+        None => message.to_string(),
+    };
+    message
+        .replace(
+            "expected u32",
+            "expected a whole number from 0 to 4294967295",
+        )
+        .replace("expected f64", "expected a number")
+        .replace("expected a sequence", "expected a list")
+        .replace("as i128", "")
+}
+
+/// A table header with the wrong number of brackets (serde's own words for it,
+/// "invalid type: map, expected a list", point nowhere near the fix).
+fn brackets(message: &str, line: &str) -> Option<String> {
+    let header = line.trim();
+    let name = header.trim_matches(|c| c == '[' || c == ']' || c == ' ');
+    if !message.starts_with("invalid type") || !header.starts_with('[') {
+        None
+    } else if header.starts_with("[[") {
+        Some(format!(
+            "`{header}` has two brackets, but a scene has one {name}: write `[{name}]`"
+        ))
+    } else {
+        Some(format!(
+            "`{header}` has one bracket, but there can be many of them: start each one with `[[{name}]]`"
+        ))
+    }
+}
+
+/// What to do about a TOML or schema error, when it is one of the usual ones.
+fn hint(message: &str) -> Option<String> {
+    if let Some(rest) = message.strip_prefix("unknown field `") {
+        let (unknown, rest) = rest.split_once('`')?;
+        let expected: Vec<&str> = rest.split('`').skip(1).step_by(2).collect();
+        return unknown_key_hint(unknown, &expected);
+    }
+    if message.starts_with("missing field `camera`") || message.starts_with("missing field `light`")
+    {
+        return Some(format!(
+            "every scene needs a camera and a light, at least:\n{SMALLEST_SCENE}"
+        ));
+    }
+    if message.starts_with("duplicate key") {
+        return Some("a key may be given once per section, and [image], [camera], [screen], [light] and [render] once per file (raystep has one camera and one point light)".into());
+    }
+    None
+}
+
+/// "did you mean" for a misspelt key, or where a key of another section belongs.
+fn unknown_key_hint(unknown: &str, expected: &[&str]) -> Option<String> {
+    let nearest = expected
+        .iter()
+        .map(|k| (strsim::damerau_levenshtein(unknown, k), *k))
+        .min()
+        .filter(|&(distance, k)| distance <= (k.chars().count() / 3).max(1));
+    if let Some((_, key)) = nearest {
+        return Some(format!("did you mean `{key}`?"));
+    }
+    let homes: Vec<&str> = SECTIONS
+        .iter()
+        .filter(|(_, keys)| keys.contains(&unknown))
+        .map(|(section, _)| *section)
+        .collect();
+    (!homes.is_empty()).then(|| format!("`{unknown}` is a key of {}", homes.join(" and ")))
 }
 
 /// Refuse an image size that is zero or too large, naming where each side came
@@ -332,6 +512,33 @@ impl SceneFile {
             None => None,
             Some(keys) => Some(keys.check(width, height)?),
         };
+        // Near the screen's plane (but not on it) rays to the screen are too short
+        // to have a direction in floating point.
+        let edges = screen.unwrap_or(Screen::for_image(width, height));
+        let size = [
+            camera.x,
+            camera.y,
+            edges.left,
+            edges.right,
+            edges.top,
+            edges.bottom,
+        ]
+        .map(f64::abs)
+        .into_iter()
+        .fold(0.0, f64::max);
+        let nearest = (MIN_RADIUS_RATIO * size).max(MIN_RADIUS);
+        if camera.z.abs() < nearest {
+            return Err(format!(
+                "camera.position: z = {} puts the eye too near the screen, which lies in the \
+                 plane z = 0: it must be at least {} away ({MIN_RADIUS_RATIO:e} × {}, the \
+                 largest coordinate of the screen's edges and the camera's x and y, and at \
+                 least {MIN_RADIUS:e}), or rays to the screen have no direction; e.g. \
+                 position = [0, 0, 1]",
+                shown(camera.z),
+                shown(nearest),
+                shown(size)
+            ));
+        }
 
         let light = Light {
             position: point(self.light.position, "light.position")?,
@@ -346,16 +553,23 @@ impl SceneFile {
         let mut objects = Vec::new();
         for (i, keys) in self.sphere.into_iter().enumerate() {
             let at = format!("[[sphere]] number {}", i + 1);
+            let shape = sphere(keys.center, keys.radius, &at)?;
+            placed(&shape, &at, camera, light.position)?;
             objects.push(Object {
-                shape: Shape::Sphere(sphere(keys.center, keys.radius, &at)?),
+                shape: Shape::Sphere(shape),
                 material: material_keys!(keys).check(&at)?,
                 role: Role::Sphere,
             });
         }
         for (i, keys) in self.plane.into_iter().enumerate() {
             let at = format!("[[plane]] number {}", i + 1);
+            let shape = keys.shape(&at)?;
+            match &shape {
+                Shape::Sphere(s) => placed(s, &format!("{at} (a sphere)"), camera, light.position)?,
+                Shape::Plane(plane) => lit_from_off(plane, &at, light.position)?,
+            }
             objects.push(Object {
-                shape: keys.shape(&at)?,
+                shape,
                 material: material_keys!(keys).check(&at)?,
                 role: Role::Floor,
             });
@@ -437,15 +651,17 @@ impl MaterialKeys {
         let shininess = number(self.shininess.unwrap_or(100.0), &key("shininess"))?;
         if shininess < 0.0 {
             return Err(format!(
-                "{}: {shininess} must be 0 or more",
-                key("shininess")
+                "{}: {} must be 0 or more",
+                key("shininess"),
+                shown(shininess)
             ));
         }
         let reflection = number(self.reflection.unwrap_or(0.5), &key("reflection"))?;
         if !(0.0..=1.0).contains(&reflection) {
             return Err(format!(
-                "{}: {reflection} must be from 0 (matte) to 1 (perfect mirror)",
-                key("reflection")
+                "{}: {} must be from 0 (matte) to 1 (perfect mirror)",
+                key("reflection"),
+                shown(reflection)
             ));
         }
         Ok(Material {
@@ -462,7 +678,10 @@ fn number(value: f64, key: &str) -> Result<f64, String> {
     if !value.is_finite() {
         Err(format!("{key}: {value} is not a finite number"))
     } else if value.abs() > MAX_MAGNITUDE {
-        Err(format!("{key}: {value} is larger than {MAX_MAGNITUDE:e} in magnitude, the most raystep accepts"))
+        Err(format!(
+            "{key}: {} is larger than {MAX_MAGNITUDE:e} in magnitude, the most raystep accepts",
+            shown(value)
+        ))
     } else {
         Ok(value)
     }
@@ -489,10 +708,94 @@ fn colour(value: Option<Triple>, default: Vec3, key: &str) -> Result<Vec3, Strin
     Ok(c)
 }
 
+/// Refuse a sphere too small for its place in the scene, and a camera or a light
+/// inside (or on) it.
+///
+/// - Its radius must be at least [`MIN_RADIUS`], and at least [`MIN_RADIUS_RATIO`]
+///   times the largest coordinate of its center and of the camera: below that,
+///   float32's rounding of a hit point is as large as the sphere, a hit point can
+///   land on the center, and its normal has no direction.
+/// - The tutorial's spheres are solid and shaded from outside: a camera inside
+///   sees only the wall, lit as if from outside, and a light inside would leave
+///   every other point in the sphere's shadow. "On" allows for rounding: within
+///   [`MIN_RADIUS_RATIO`] of the scene's size of the surface.
+fn placed(s: &Sphere, at: &str, camera: Vec3, light: Vec3) -> Result<(), String> {
+    let size = s.center.abs().max_element().max(camera.abs().max_element());
+    let smallest = (MIN_RADIUS_RATIO * size).max(MIN_RADIUS);
+    if s.radius < smallest {
+        return Err(format!(
+            "{at}, radius: {} is smaller than {}, the least raystep accepts here \
+             ({MIN_RADIUS_RATIO:e} × {}, the largest coordinate of its center and of the \
+             camera, and at least {MIN_RADIUS:e}): float32 would round its hit points by more \
+             than its size; make it larger or scale the whole scene",
+            shown(s.radius),
+            shown(smallest),
+            shown(size)
+        ));
+    }
+    let margin = MIN_RADIUS_RATIO * size.max(s.radius);
+    let inside = |p: Vec3| (p - s.center).length() <= s.radius + margin;
+    let described = format!(
+        "{at} (center {}, radius {})",
+        vector(s.center),
+        shown(s.radius)
+    );
+    if inside(camera) {
+        return Err(format!(
+            "camera.position {} is inside {described}: the camera would see only the \
+             inside of that sphere's wall; move the camera or the sphere",
+            vector(camera)
+        ));
+    }
+    if inside(light) {
+        return Err(format!(
+            "light.position {} is inside {described}: no light could leave it, so every \
+             other point would be in shadow; move the light or the sphere",
+            vector(light)
+        ));
+    }
+    Ok(())
+}
+
+/// Refuse a light on a true plane (within [`MIN_RADIUS_RATIO`] of the scene's size
+/// of it): the plane would be lit edge-on, and a point of it could be the light
+/// itself, from which no direction leads to the light.
+fn lit_from_off(plane: &Plane, at: &str, light: Vec3) -> Result<(), String> {
+    let size = light
+        .abs()
+        .max_element()
+        .max(plane.point.abs().max_element());
+    if (light - plane.point).dot(plane.normal).abs() <= MIN_RADIUS_RATIO * size {
+        return Err(format!(
+            "light.position {} lies on {at}: the plane would be lit edge-on, and the light \
+             would be a point of it; move the light off the plane",
+            vector(light)
+        ));
+    }
+    Ok(())
+}
+
+/// `[x, y, z]` as a scene file writes it.
+fn vector(v: Vec3) -> String {
+    format!("[{}, {}, {}]", shown(v.x), shown(v.y), shown(v.z))
+}
+
+/// A number as a message shows it: `1e-300`, not three hundred zeros.
+fn shown(v: f64) -> String {
+    if v != 0.0 && !(1e-4..1e16).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 fn sphere(center: Triple, radius: f64, at: &str) -> Result<Sphere, String> {
     let radius = number(radius, &format!("{at}, radius"))?;
     if radius <= 0.0 {
-        return Err(format!("{at}, radius: {radius} must be greater than 0"));
+        return Err(format!(
+            "{at}, radius: {} must be greater than 0",
+            shown(radius)
+        ));
     }
     Ok(Sphere {
         center: point(center, &format!("{at}, center"))?,

@@ -379,13 +379,17 @@ proptest! {
         let cam = if cam.z == 0.0 { Vec3::new(cam.x, cam.y, s) } else { cam };
         let light = if light_inside { c0 + light * r0 * 0.5 } else { light * s * 3.0 };
         let mut toml = String::new();
-        toml += &format!("[image]\nwidth = 8\nheight = 6\n[camera]\nposition = [{}, {}, {}]\n", cam.x, cam.y, cam.z);
-        toml += &format!("[light]\nposition = [{}, {}, {}]\n", light.x, light.y, light.z);
+        // The loader refuses a camera or a light inside a sphere, so they are put
+        // in place after it: the renderer must stay finite for a scene built in
+        // code, too.
+        toml += &format!("[image]\nwidth = 8\nheight = 6\n[camera]\nposition = [0, 0, {}]\n", 10.0 * s);
+        toml += &format!("[light]\nposition = [0, {}, 0]\n", 10.0 * s);
         for (c, (_, r)) in centers.iter().zip(&spheres) {
             toml += &format!("[[sphere]]\ncenter = [{}, {}, {}]\nradius = {}\n", c.x, c.y, c.z, r * s);
         }
         toml += &format!("[[plane]]\npoint = [0, {}, 0]\nnormal = [0, 1, 0]\n", -s);
-        let scene = raystep::scene_file::parse(&toml, "generated").unwrap();
+        let mut scene = raystep::scene_file::parse(&toml, "generated").unwrap();
+        (scene.camera, scene.light.position) = (cam, light);
         let settings = Settings {
             precision: if f32_precision { F32 } else { F64 },
             method: if naive { Naive } else { Stable },
@@ -435,9 +439,11 @@ fn tangent_rays_and_a_light_inside_a_sphere_give_finite_pixels() {
     // A pixel whose ray touches the sphere exactly (Δ = 0): the 3 × 3 image's middle
     // column looks at x = 0, and the sphere's left edge is at x = 0 on that plane.
     let toml = "[image]\nwidth = 3\nheight = 3\n[camera]\nposition = [0, 0, 1]\n\
-                [light]\nposition = [1, 0, -2]\n[[sphere]]\ncenter = [1, 0, -2]\nradius = 1\n\
+                [light]\nposition = [5, 5, 5]\n[[sphere]]\ncenter = [1, 0, -2]\nradius = 1\n\
                 [[plane]]\npoint = [0, -1, 0]\nnormal = [0, 1, 0]\n";
-    let scene = raystep::scene_file::parse(toml, "tangent").unwrap();
+    let mut scene = raystep::scene_file::parse(toml, "tangent").unwrap();
+    // At the sphere's centre: the loader refuses that, a scene built in code need not.
+    scene.light.position = raystep::Vec3::new(1.0, 0.0, -2.0);
     for precision in [F32, F64] {
         for method in [Naive, Stable] {
             let settings = Settings {

@@ -1,16 +1,12 @@
 //! The `raystep` binary as a user runs it: the default command, `render`, `check`,
-//! and mistakes, which must end in one clear message and exit code 2.
+//! `diff`, `bench`, `generate` and `chart`. Mistakes (a corpus of them, each with
+//! the message it must end in) are in `tests/hostile.rs`.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn raystep(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raystep"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the binary runs")
-}
+mod common;
+use common::raystep;
 
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
@@ -192,79 +188,6 @@ fn scene_with(extra: &str) -> String {
     format!("[camera]\nposition = [0, 0, 1]\n[light]\nposition = [5, 5, 5]\n{extra}")
 }
 
-/// What went wrong, the scene file's text (None: no file), extra arguments, and the
-/// words the message must hold.
-type Case<'a> = (&'a str, Option<String>, Vec<&'a str>, Vec<&'a str>);
-
-#[test]
-fn mistakes_end_in_one_clear_message_and_exit_code_2() {
-    let sphere = |keys: &str| scene_with(&format!("[[sphere]]\ncenter = [0, 0, -1]\n{keys}\n"));
-    let cases: Vec<Case> = vec![
-        ("missing file", None, vec!["render", "nowhere.toml"], vec!["nowhere.toml", "cannot read"]),
-        ("TOML syntax", Some("[camera\nposition = [0, 0, 1]".into()), vec![], vec!["bad.toml", "line 1"]),
-        ("unknown key", Some(sphere("radus = 1")), vec![], vec!["unknown field `radus`", "radius"]),
-        ("wrong type", Some(sphere("radius = \"big\"")), vec![], vec!["invalid type", "radius", "line 7"]),
-        ("missing required key", Some(sphere("")), vec![], vec!["missing field `radius`"]),
-        ("missing camera", Some("[light]\nposition = [5, 5, 5]\n".into()), vec![], vec!["missing field `camera`"]),
-        ("negative radius", Some(sphere("radius = -1")), vec![], vec!["[[sphere]] number 1, radius", "greater than 0"]),
-        ("zero radius", Some(sphere("radius = 0")), vec![], vec!["radius", "greater than 0"]),
-        ("NaN", Some(sphere("radius = nan")), vec![], vec!["radius", "not a finite number"]),
-        ("infinity", Some(scene_with("[[sphere]]\ncenter = [0, inf, -1]\nradius = 1\n")), vec![], vec!["center", "not a finite number"]),
-        ("empty screen", Some(scene_with("[screen]\nleft = 1\nright = 1\n")), vec![], vec!["screen", "left (1) must be less than right (1)"]),
-        ("camera on the screen plane", Some("[camera]\nposition = [0, 0, 0]\n[light]\nposition = [5, 5, 5]\n".into()), vec![], vec!["camera.position", "z = 0"]),
-        ("zero-size image in the file", Some(scene_with("[image]\nwidth = 0\n")), vec![], vec!["image.width = 0", "1 to 16384"]),
-        ("negative size in the file", Some(scene_with("[image]\nheight = -5\n")), vec![], vec!["height", "invalid value"]),
-        ("zero width flag", Some(scene_with("")), vec!["--width", "0"], vec!["--width = 0", "1 to 16384"]),
-        ("absurd height flag", Some(scene_with("")), vec!["--height", "20000"], vec!["--height = 20000", "1 to 16384"]),
-        ("too many pixels", Some(scene_with("")), vec!["--width", "16384", "--height", "16384"], vec!["--width = 16384 and --height = 16384 make 268435456 pixels", "at most 33177600"]),
-        ("max_depth 0", Some(scene_with("[render]\nmax_depth = 0\n")), vec![], vec!["render.max_depth = 0", "from 1 to 64"]),
-        ("reflection above 1", Some(sphere("radius = 1\nreflection = 2")), vec![], vec!["reflection", "from 0 (matte) to 1"]),
-        ("negative colour", Some(sphere("radius = 1\ndiffuse = [0.5, -1, 0]")), vec![], vec!["diffuse", "negative"]),
-        ("plane with two shapes", Some(scene_with("[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\nsphere = { center = [0, -9, 0], radius = 8 }\n")), vec![], vec!["[[plane]] number 1", "not both"]),
-        ("plane with a zero normal", Some(scene_with("[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 0, 0]\n")), vec![], vec!["normal", "non-zero"]),
-        ("a fourth number in a vector", Some(scene_with("[[sphere]]\ncenter = [0, 0, -1, 5]\nradius = 1\n")), vec![], vec!["center", "expected three numbers [x, y, z], found 4"]),
-        ("a huge number", Some(sphere("radius = 1e300")), vec![], vec!["radius", "larger than 1e15"]),
-        ("a stage that is off already", Some(scene_with("")), vec!["--stage", "shadow", "--without", "plane"], vec!["--without plane does nothing"]),
-        ("a stage without what it needs", Some(scene_with("")), vec!["--stage", "shadow", "--without", "intersection"], vec!["`shadow` cannot run without `intersection`"]),
-        ("unknown stage", Some(scene_with("")), vec!["--stage", "shadows"], vec!["invalid value 'shadows'", "shadow"]),
-        ("offset without a kind", Some(scene_with("")), vec!["--offset", "1e-5"], vec!["--offset", "expected auto or fixed:VALUE"]),
-        ("negative offset", Some(scene_with("")), vec!["--offset", "fixed:-1"], vec!["--offset", "0 or more"]),
-        ("max-depth flag 0", Some(scene_with("")), vec!["--max-depth", "0"], vec!["--max-depth = 0", "from 1 to 64"]),
-        ("unknown viewer", Some(scene_with("")), vec!["--viewer", "eye"], vec!["invalid value 'eye'", "ray-origin"]),
-        ("output folder is a file", Some(scene_with("")), vec!["--out", "bad.toml"], vec!["bad.toml", "is a file"]),
-        ("output folder inside a file", Some(scene_with("")), vec!["--out", "bad.toml/sub"], vec!["bad.toml/sub", "cannot create"]),
-    ];
-    for (what, file, extra, words) in cases {
-        let dir = tempfile::tempdir().unwrap();
-        let mut args: Vec<&str> = vec![];
-        if let Some(text) = &file {
-            std::fs::write(dir.path().join("bad.toml"), text).unwrap();
-            args.extend(["render", "bad.toml"]);
-        }
-        args.extend(extra);
-        let out = raystep(dir.path(), &args);
-        let stderr = text(&out.stderr);
-        assert_eq!(
-            out.status.code(),
-            Some(2),
-            "{what}: exit code; stderr:\n{stderr}"
-        );
-        assert!(
-            !stderr.contains("panicked") && !stderr.contains("backtrace"),
-            "{what}:\n{stderr}"
-        );
-        for word in words {
-            assert!(stderr.contains(word), "{what}: {word:?} not in:\n{stderr}");
-        }
-        // Nothing was written: the folder holds at most the scene file.
-        let left: Vec<_> = std::fs::read_dir(dir.path())
-            .unwrap()
-            .map(|e| e.unwrap().file_name())
-            .collect();
-        assert!(left.len() <= 1, "{what}: left {left:?}");
-    }
-}
-
 #[test]
 fn diff_compares_two_renders_and_refuses_two_sizes() {
     let dir = tempfile::tempdir().unwrap();
@@ -340,27 +263,6 @@ fn a_closed_stdout_is_not_a_crash() {
 }
 
 #[test]
-fn a_file_that_is_not_text_or_never_ends_is_refused() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("binary.toml"), [0xff, 0xfe, 0x00, 0x12]).unwrap();
-    let out = raystep(dir.path(), &["check", "binary.toml"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(
-        text(&out.stderr).contains("binary.toml: is not a text file (not UTF-8)"),
-        "{}",
-        text(&out.stderr)
-    );
-    // A device has no length to check beforehand; reading stops past the limit.
-    let out = raystep(dir.path(), &["check", "/dev/zero"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(
-        text(&out.stderr).contains("/dev/zero: is larger than 16777216 bytes"),
-        "{}",
-        text(&out.stderr)
-    );
-}
-
-#[test]
 fn size_flags_override_a_size_the_file_gets_wrong() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(
@@ -424,34 +326,6 @@ fn generate_writes_a_scene_that_loads_and_refuses_a_count_of_zero() {
     assert_eq!(out.stdout, again.stdout, "the same seed, the same bytes");
     let zero = raystep(dir.path(), &["generate", "spheres", "--count", "0"]);
     assert_eq!(zero.status.code(), Some(2));
-}
-
-#[test]
-fn spp_must_be_a_square_and_chart_scale_takes_no_scene() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = raystep(
-        dir.path(),
-        &["render", "--spp", "5", "--width", "8", "--height", "8"],
-    );
-    assert_eq!(out.status.code(), Some(2));
-    assert!(
-        text(&out.stderr).contains("square number"),
-        "{}",
-        text(&out.stderr)
-    );
-    let out = raystep(dir.path(), &["render", "--spp", "2000"]);
-    assert!(
-        text(&out.stderr).contains("from 1 to 1024"),
-        "{}",
-        text(&out.stderr)
-    );
-    let out = raystep(dir.path(), &["chart", "--scale", "scene.toml"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(
-        text(&out.stderr).contains("takes no scene file"),
-        "{}",
-        text(&out.stderr)
-    );
 }
 
 #[test]

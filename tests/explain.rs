@@ -4,8 +4,6 @@
 
 mod common;
 
-use std::process::Command;
-
 use raystep::aov::{Frame, PixelRecord, NO_OBJECT};
 use raystep::explain::{explain, Explanation};
 use raystep::real::Precision;
@@ -164,10 +162,7 @@ fn telling_pixels_of_the_seed_scene() {
 }
 
 fn raystep(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_raystep"))
-        .args(args)
-        .output()
-        .unwrap()
+    common::raystep(std::path::Path::new("."), args)
 }
 
 #[test]

@@ -55,6 +55,10 @@ function loadStage(folder) {
   if (stageData.has(folder)) {
     return; // loaded, loading, or failed already
   }
+  if (!MANIFEST.numbers) {
+    stageData.set(folder, "absent"); // too large a render: raystep did not write them
+    return;
+  }
   stageData.set(folder, "loading");
   const script = document.createElement("script");
   script.src = folder + "/pixels.js";
@@ -229,7 +233,15 @@ function show() {
 
   let state;
   let status = "";
-  if (data === "failed") {
+  if (data === "absent") {
+    state = "absent";
+    status =
+      "This render is too large for the page to hold its numbers (pixels.js is written up to " +
+      MANIFEST.numbersUpTo +
+      " pixels). Read a pixel with raystep explain --pixel " +
+      (pointer ? pointer.x + "," + pointer.y : "X,Y") +
+      " (and the same size flags), or open buffers.exr.";
+  } else if (data === "failed") {
     state = "error";
     status = "Cannot load " + folder + "/pixels.js: run raystep stages again to write it.";
   } else if (!pointer) {

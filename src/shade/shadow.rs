@@ -41,7 +41,7 @@ impl Offset {
 impl std::str::FromStr for Offset {
     type Err = String;
 
-    /// `auto`, or `fixed:VALUE` with VALUE a finite number, 0 or more (e.g. `fixed:1e-5`).
+    /// `auto`, or `fixed:VALUE` with VALUE from 0 to 1e15 (e.g. `fixed:1e-5`).
     fn from_str(text: &str) -> Result<Offset, String> {
         if text == "auto" {
             return Ok(Offset::Auto);
@@ -50,9 +50,10 @@ impl std::str::FromStr for Offset {
             .strip_prefix("fixed:")
             .ok_or_else(|| format!("`{text}`: expected auto or fixed:VALUE, e.g. fixed:1e-5"))?;
         match value.parse::<f64>() {
-            Ok(v) if v.is_finite() && v >= 0.0 => Ok(Offset::Fixed(v)),
+            Ok(v) if (0.0..=crate::scene_file::MAX_MAGNITUDE).contains(&v) => Ok(Offset::Fixed(v)),
             _ => Err(format!(
-                "`{value}`: the offset must be a finite number, 0 or more"
+                "`{value}`: the offset must be a number from 0 to {:e}",
+                crate::scene_file::MAX_MAGNITUDE
             )),
         }
     }

@@ -56,3 +56,12 @@ pub fn read_pfm(bytes: &[u8]) -> (usize, usize, Vec<[f32; 3]>) {
     }
     (w, h, rows)
 }
+
+/// Run the `raystep` binary with `args` in the folder `dir`.
+pub fn raystep(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_raystep"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the binary runs")
+}

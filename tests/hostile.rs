@@ -1,0 +1,518 @@
+//! Hostile input: every mistake a user can type or write in a scene ends in one
+//! clear message and exit code 2, never a panic, a hang, a NaN image or a lost
+//! file; and an interrupted or killed render leaves the files of the render before
+//! it as they were.
+//!
+//! The corpus is in `tests/hostile/`:
+//!
+//! - `scenes/*.toml`: one bad (or odd but valid) scene file each. Its first lines
+//!   say what is wrong with it and what raystep must answer:
+//!   `# expect-exit: 2` and one `# expect: TEXT` per text the message must hold.
+//! - `commands.toml`: command lines, with the exit code and texts each must give.
+//!
+//! A case is added by adding a file or a `[[case]]`; nothing here needs to change.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use serde::Deserialize;
+
+mod common;
+use common::raystep;
+
+fn corpus() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hostile")
+}
+
+/// What a case expects: the exit code and the texts the output must hold.
+#[derive(Debug, Deserialize)]
+struct Expected {
+    exit: i32,
+    expect: Vec<String>,
+}
+
+/// The expectations written at the top of a scene file of the corpus.
+fn expected_of(text: &str) -> Expected {
+    let mut exit = None;
+    let mut expect = Vec::new();
+    for line in text.lines().map(|l| l.trim_end_matches('\r')) {
+        if let Some(code) = line.strip_prefix("# expect-exit: ") {
+            exit = Some(code.parse().expect("an exit code"));
+        } else if let Some(words) = line.strip_prefix("# expect: ") {
+            expect.push(words.to_string());
+        }
+    }
+    Expected {
+        exit: exit.expect("every corpus file says `# expect-exit: N`"),
+        expect,
+    }
+}
+
+/// Check one run against `expected`; `what` names the case in failures.
+fn check_output(what: &str, out: &Output, expected: &Expected) {
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let said = format!("{stderr}{stdout}");
+    assert_eq!(
+        out.status.code(),
+        Some(expected.exit),
+        "{what}: exit code; it said:\n{said}"
+    );
+    assert!(
+        !said.contains("panicked") && !said.contains("RUST_BACKTRACE"),
+        "{what}: a panic:\n{said}"
+    );
+    for words in &expected.expect {
+        assert!(
+            said.contains(words.as_str()),
+            "{what}: {words:?} is not in:\n{said}"
+        );
+    }
+    if expected.exit != 0 {
+        // One message, on stderr, and nothing on stdout.
+        assert_eq!(
+            stderr.matches("error:").count(),
+            1,
+            "{what}: one message:\n{stderr}"
+        );
+        assert_eq!(stdout, "", "{what}: stdout");
+    }
+}
+
+/// Every file in `dir` (hidden ones too, and in sub-folders), with its bytes.
+fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut found = BTreeMap::new();
+    let mut folders = vec![dir.to_path_buf()];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                folders.push(path);
+            } else {
+                let name = path.strip_prefix(dir).unwrap().display().to_string();
+                found.insert(name, std::fs::read(&path).unwrap());
+            }
+        }
+    }
+    found
+}
+
+/// Every name under `dir`, folders included.
+fn names(dir: &Path) -> Vec<String> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        found.push(path.strip_prefix(dir).unwrap().display().to_string());
+        if path.is_dir() {
+            found.extend(
+                names(&path)
+                    .into_iter()
+                    .map(|n| format!("{}/{n}", path.file_name().unwrap().to_string_lossy())),
+            );
+        }
+    }
+    found.sort();
+    found
+}
+
+/// The scene files of the corpus, sorted by name.
+fn scene_files() -> Vec<PathBuf> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(corpus().join("scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    paths.sort();
+    paths
+}
+
+#[derive(Deserialize)]
+struct Commands {
+    case: Vec<CommandCase>,
+}
+
+#[derive(Deserialize)]
+struct CommandCase {
+    what: String,
+    args: Vec<String>,
+    #[serde(flatten)]
+    expected: Expected,
+}
+
+fn command_cases() -> Vec<CommandCase> {
+    let text = std::fs::read_to_string(corpus().join("commands.toml")).unwrap();
+    toml::from_str::<Commands>(&text).unwrap().case
+}
+
+/// The smallest scene, with one sphere.
+const OK_SCENE: &str = "[camera]\nposition = [0, 0, 1]\n[light]\nposition = [5, 5, 5]\n\
+                        [[sphere]]\ncenter = [0, 0, -1]\nradius = 0.5\n";
+
+/// Files the command cases name as `{fixtures}/…`, made once.
+fn fixtures() -> &'static Path {
+    static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let at = |name: &str| dir.path().join(name);
+        std::fs::write(at("binary.toml"), [0xff, 0xfe, 0x00, 0x12, 0x9c]).unwrap();
+        std::fs::write(at("empty.toml"), "").unwrap();
+        // 100 MB that take no room: the file is sparse.
+        let huge = std::fs::File::create(at("huge.toml")).unwrap();
+        huge.set_len(100_000_000).unwrap();
+        std::fs::write(at("bom.toml"), format!("\u{feff}{OK_SCENE}")).unwrap();
+        let out = raystep(
+            dir.path(),
+            &["render", "--width", "40", "--height", "30", "--out", "good"],
+        );
+        assert!(out.status.success());
+        let exr = std::fs::read(at("good/buffers.exr")).unwrap();
+        std::fs::copy(at("good/buffers.exr"), at("good.exr")).unwrap();
+        std::fs::copy(at("good/beauty.png"), at("beauty.png")).unwrap();
+        std::fs::write(at("truncated.exr"), &exr[..exr.len() / 3]).unwrap();
+        let mut noise = exr.clone();
+        for i in (400..noise.len()).step_by(97) {
+            noise[i] ^= 0x5a;
+        }
+        std::fs::write(at("noise.exr"), noise).unwrap();
+        // The header's dataWindow (a box2i: x min, y min, x max, y max) made huge.
+        let mut huge_header = exr;
+        let key = b"dataWindow\0box2i\0";
+        let at_box = huge_header
+            .windows(key.len())
+            .position(|w| w == key)
+            .expect("a dataWindow attribute")
+            + key.len()
+            + 4;
+        for corner in [8, 12] {
+            huge_header[at_box + corner..at_box + corner + 4]
+                .copy_from_slice(&1_999_999i32.to_le_bytes());
+        }
+        std::fs::write(at("huge-header.exr"), huge_header).unwrap();
+        dir
+    })
+    .path()
+}
+
+#[test]
+fn every_bad_scene_file_ends_in_its_message_and_writes_nothing() {
+    let paths = scene_files();
+    for path in &paths {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let text = std::fs::read_to_string(path).unwrap();
+        let expected = expected_of(&text);
+        let dir = tempfile::tempdir().unwrap();
+        let file = path.to_str().unwrap();
+        // `check` and `render` load the same way and must say the same.
+        for args in [&["check", file][..], &["render", file, "--out", "out"]] {
+            let out = raystep(dir.path(), args);
+            let what = format!("{name} ({})", args[0]);
+            check_output(&what, &out, &expected);
+            if expected.exit != 0 {
+                assert!(
+                    String::from_utf8_lossy(&out.stderr).contains(file),
+                    "{what}: the message names the file"
+                );
+                assert_eq!(names(dir.path()), Vec::<String>::new(), "{what}: wrote");
+            }
+        }
+        if expected.exit == 0 {
+            // What is accepted renders to finite colours in [0, 1].
+            let exr = dir.path().join("out/buffers.exr");
+            let (_, _, pixels) = raystep::compare::read_beauty(&exr).unwrap();
+            assert!(
+                pixels.iter().flatten().all(|c| (0.0..=1.0).contains(c)),
+                "{name}: a colour outside [0, 1]"
+            );
+        }
+    }
+    assert!(paths.len() >= 70, "{} scene files", paths.len());
+}
+
+#[test]
+fn every_bad_command_line_ends_in_its_message_and_writes_nothing() {
+    let fixtures = fixtures().to_str().unwrap().to_string();
+    let cases = command_cases();
+    for case in &cases {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("ok.toml"), OK_SCENE).unwrap();
+        std::fs::write(dir.path().join("notes.txt"), "not a folder").unwrap();
+        let before = files(dir.path());
+        let args: Vec<String> = case
+            .args
+            .iter()
+            .map(|a| a.replace("{fixtures}", &fixtures))
+            .collect();
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let start = Instant::now();
+        let out = raystep(dir.path(), &args);
+        check_output(&case.what, &out, &case.expected);
+        if case.expected.exit != 0 {
+            assert_eq!(files(dir.path()), before, "{}: wrote", case.what);
+            // Refused before any work: a mistake is told at once.
+            assert!(
+                start.elapsed() < Duration::from_secs(20),
+                "{}: took {:?}",
+                case.what,
+                start.elapsed()
+            );
+        }
+    }
+    assert!(cases.len() >= 50, "{} command cases", cases.len());
+}
+
+/// The output folder of a case where the user cannot write (only when not root:
+/// root may write anywhere).
+#[test]
+fn a_folder_without_write_permission_is_refused_before_rendering() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let locked = dir.path().join("locked");
+    std::fs::create_dir(&locked).unwrap();
+    std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o555)).unwrap();
+    if std::fs::write(locked.join("probe"), "").is_ok() {
+        eprintln!("skipped: this user (root) may write into a read-only folder");
+        return;
+    }
+    let out = raystep(dir.path(), &["render", "--out", "locked"]);
+    check_output(
+        "a read-only folder",
+        &out,
+        &Expected {
+            exit: 2,
+            expect: vec![
+                "cannot write locked".into(),
+                "cannot write files in the output folder".into(),
+                "Permission denied".into(),
+            ],
+        },
+    );
+}
+
+#[test]
+fn raystep_writes_only_the_names_it_owns() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    // A user's own files beside the outputs, and names close to raystep's.
+    let mine = [
+        ("notes.txt", "my notes"),
+        ("beauty.png.bak", "an old copy"),
+        (".beauty.png.tmp", "another program's temporary"),
+        ("01-rays/my-sketch.svg", "<svg/>"),
+    ];
+    std::fs::create_dir(out.join("01-rays")).unwrap();
+    for (name, text) in mine {
+        std::fs::write(out.join(name), text).unwrap();
+    }
+    for args in [
+        &["stages", "--width", "40", "--height", "30"][..],
+        &[
+            "render", "--stage", "rays", "--width", "40", "--height", "30",
+        ],
+    ] {
+        let run = raystep(dir.path(), args);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        for (name, text) in mine {
+            assert_eq!(
+                std::fs::read_to_string(out.join(name)).unwrap(),
+                text,
+                "{name}"
+            );
+        }
+    }
+    // What is there: the user's files and raystep's own names, nothing else.
+    let owned: Vec<String> = names(&out)
+        .into_iter()
+        .filter(|n| !mine.iter().any(|(m, _)| m == n))
+        .collect();
+    for name in &owned {
+        let file = name.rsplit('/').next().unwrap();
+        let known = file.ends_with(".png")
+            || ["buffers.exr", "pixels.js", "index.html"].contains(&file)
+            || (name.matches('/').count() == 0 && name.starts_with("0"));
+        assert!(known, "raystep wrote {name}");
+        assert!(!file.ends_with(".tmp"), "a temporary file was left: {name}");
+    }
+}
+
+/// Send `signal` (`-INT`, `-KILL`) to a process.
+fn send(signal: &str, pid: u32) {
+    let status = Command::new("kill")
+        .args([signal, &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success(), "kill {signal} {pid}");
+}
+
+/// Run `args` in `dir` and send `signal` after `delay` (if it is still running);
+/// returns its exit code (None: ended by the signal).
+fn interrupted(dir: &Path, args: &[&str], signal: &str, delay: Duration) -> Option<i32> {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_raystep"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(delay);
+    if child.try_wait().unwrap().is_none() {
+        send(signal, child.id());
+    }
+    child.wait().unwrap().code()
+}
+
+/// The files of folder `out` made by `args` in a fresh folder, and how long it took.
+fn made_by(args: &[&str]) -> (BTreeMap<String, Vec<u8>>, Duration) {
+    let dir = tempfile::tempdir().unwrap();
+    let start = Instant::now();
+    let run = raystep(dir.path(), args);
+    let took = start.elapsed();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    (files(&dir.path().join("out")), took)
+}
+
+/// The old render, then the new one interrupted (SIGINT) at several moments from
+/// its start to its end: each time the folder holds the old files exactly (exit
+/// 130), or, if the signal came after the new files were in place, the new ones
+/// exactly (exit 0). Never a mixture, never a temporary file.
+fn interrupting(old: &[&str], new: &[&str]) {
+    let (old_files, _) = made_by(old);
+    let (new_files, took) = made_by(new);
+    let mut outcomes = BTreeMap::new();
+    for tenth in [1, 3, 5, 7, 9, 12] {
+        let dir = tempfile::tempdir().unwrap();
+        assert!(raystep(dir.path(), old).status.success());
+        let delay = took * tenth / 10;
+        let code = interrupted(dir.path(), new, "-INT", delay);
+        let now = files(&dir.path().join("out"));
+        match code {
+            Some(130) => assert!(
+                now == old_files,
+                "interrupted at {delay:?}: not the old files"
+            ),
+            Some(0) => assert!(now == new_files, "done at {delay:?}: not the new files"),
+            other => panic!("exit {other:?} after SIGINT at {delay:?}"),
+        }
+        *outcomes.entry(code).or_insert(0) += 1;
+    }
+    // The early signals did interrupt (the test would prove nothing otherwise).
+    assert!(
+        outcomes.get(&Some(130)).is_some_and(|&n| n >= 2),
+        "{outcomes:?}"
+    );
+}
+
+#[test]
+fn ctrl_c_during_a_render_leaves_the_previous_files_as_they_were() {
+    interrupting(
+        &[
+            "render", "--stage", "shadow", "--width", "64", "--height", "48",
+        ],
+        &["render", "--width", "600", "--height", "400"],
+    );
+}
+
+#[test]
+fn ctrl_c_during_stages_leaves_every_stage_of_the_previous_run() {
+    interrupting(
+        &["stages", "--width", "64", "--height", "48"],
+        &["stages", "--width", "200", "--height", "150"],
+    );
+}
+
+#[test]
+fn a_killed_render_leaves_whole_files_and_the_next_run_clears_its_temporaries() {
+    let old: &[&str] = &[
+        "render", "--stage", "shadow", "--width", "64", "--height", "48",
+    ];
+    let new: &[&str] = &["render", "--width", "600", "--height", "400"];
+    let (old_files, _) = made_by(old);
+    let (new_files, took) = made_by(new);
+    let mut left_temporaries = 0;
+    for tenth in [2, 5, 8, 9] {
+        let dir = tempfile::tempdir().unwrap();
+        assert!(raystep(dir.path(), old).status.success());
+        let delay = took * tenth / 10;
+        interrupted(dir.path(), new, "-KILL", delay);
+        let out = dir.path().join("out");
+        // Every file is whole: the old one, or the new one.
+        for (name, bytes) in files(&out) {
+            let file = name.rsplit('/').next().unwrap();
+            if file.starts_with('.') && file.ends_with(".raystep.tmp") {
+                left_temporaries += 1;
+                continue;
+            }
+            let whole =
+                old_files.get(&name) == Some(&bytes) || new_files.get(&name) == Some(&bytes);
+            assert!(
+                whole,
+                "killed at {delay:?}: {name} is neither the old nor the new file"
+            );
+        }
+        // The next run into the folder removes what the killed one left, and what
+        // a process long gone left (no process has a number this large).
+        std::fs::write(out.join(".beauty.png.999999999.raystep.tmp"), "half").unwrap();
+        assert!(raystep(dir.path(), old).status.success());
+        assert_eq!(
+            files(&out),
+            old_files,
+            "killed at {delay:?}, then run again"
+        );
+    }
+    // Whether a kill landed while files were being written depends on the moment.
+    eprintln!("{left_temporaries} temporary files were left by the kills");
+}
+
+#[test]
+fn help_states_every_limit_with_the_numbers_the_code_uses() {
+    use raystep::scene_file::*;
+    let help = raystep(Path::new("."), &["--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(
+        help.contains(raystep::cli::LIMITS),
+        "--help ends with the limits"
+    );
+    let (w, h) = (7680u64, 4320u64);
+    assert_eq!(w * h, MAX_PIXELS);
+    let gigabytes = format!("{:.1} GB", (MAX_PIXELS * PEAK_BYTES_PER_PIXEL) as f64 / 1e9);
+    for stated in [
+        format!("1 to {MAX_SIDE} pixels a side"),
+        format!("{w} × {h} in all"),
+        format!("about {PEAK_BYTES_PER_PIXEL} bytes of memory per pixel ({gigabytes} at the most)"),
+        format!("1 to {MAX_DEPTH} segments"),
+        format!("from 1 to {MAX_SPP}"),
+        format!("at most {MAX_MAGNITUDE:e} in magnitude"),
+        format!("a radius at least {MIN_RADIUS:e} and\n                 {MIN_RADIUS_RATIO:e} of"),
+        format!("at most {} MiB", MAX_FILE_BYTES / (1024 * 1024)),
+    ] {
+        assert!(
+            raystep::cli::LIMITS.contains(&stated),
+            "{stated:?} in the limits"
+        );
+    }
+}
+
+#[test]
+fn chapter_1_quotes_the_message_raystep_gives() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let chapter = std::fs::read_to_string(root.join("chapters/01-scene.md")).unwrap();
+    let command = "$ raystep check tests/hostile/scenes/unknown-radus.toml\n";
+    let quoted = chapter
+        .split(command)
+        .nth(1)
+        .expect("the chapter runs the command");
+    let quoted = &quoted[..quoted.find("```").unwrap()];
+    let out = raystep(root, &["check", "tests/hostile/scenes/unknown-radus.toml"]);
+    assert_eq!(quoted, String::from_utf8_lossy(&out.stderr));
+}
