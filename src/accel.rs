@@ -113,28 +113,28 @@ impl TileMasks {
                     camera.screen_point_at::<f64>(r1, c1) - origin,
                     camera.screen_point_at::<f64>(r1, c0) - origin,
                 ];
-                let inside = corners.iter().fold(Vec3::ZERO, |a, &c| a + c);
-                let planes: [Vec3; 4] = std::array::from_fn(|i| {
-                    let (a, b) = (corners[i], corners[(i + 1) % 4]);
-                    let n = a.cross(b);
-                    // Edges less than 1e-6 apart in angle (a screen almost without
-                    // height or width) give a plane whose rounding the margin does
-                    // not cover: such a tile gets no plane (NaN), so no mask.
-                    if n.length() >= 1e-6 * a.length() * b.length() {
-                        let n = n.normalize();
-                        if n.dot(inside) < 0.0 {
-                            -n
-                        } else {
-                            n
-                        }
-                    } else {
-                        Vec3::NAN
-                    }
+                let edge = |i: usize| (corners[i], corners[(i + 1) % 4]);
+                // Edges less than 1e-6 apart in angle (a screen almost without
+                // height or width) give planes whose rounding the margin does not
+                // cover: such a tile gets no mask.
+                let wide = (0..4).all(|i| {
+                    let (a, b) = edge(i);
+                    a.cross(b).length() >= 1e-6 * a.length() * b.length()
                 });
-                if !planes.iter().all(|n| n.is_finite()) {
+                if !wide {
                     masks.push(EVERY);
                     continue;
                 }
+                let inside = corners.iter().fold(Vec3::ZERO, |a, &c| a + c);
+                let planes: [Vec3; 4] = std::array::from_fn(|i| {
+                    let (a, b) = edge(i);
+                    let n = a.cross(b).normalize();
+                    if n.dot(inside) < 0.0 {
+                        -n
+                    } else {
+                        n
+                    }
+                });
                 // ANCHOR: tile_test
                 let mut mask = 0u64;
                 for (i, sphere) in spheres.iter().enumerate() {

@@ -10,9 +10,10 @@
 
 use serde::Serialize;
 
+use crate::output::to_byte;
 use crate::ray::Ray;
 use crate::real::{Real, Vector};
-use crate::render::{Settings, Tracer, HALF_STEP};
+use crate::render::{direction_colour, Settings, Tracer, HALF_STEP};
 use crate::scene::{nearest_hit, Object, Role, Scene, Shape};
 use crate::shade::blinn_phong::{self, Viewer};
 use crate::shade::{reflection, shadow};
@@ -199,12 +200,12 @@ fn explain_in<T: Real>(scene: &Scene, settings: &Settings, x: u32, y: u32) -> Ex
         rays: [1, 0, 0],
     };
     if !settings.stages.intersection {
-        let colour = (primary.direction.to_f64() + Vec3::ONE) * 0.5;
+        let colour = direction_colour(primary.direction.to_f64());
         story.end = "only the rays stage is on: the colour shows the ray's direction, \
                      each component mapped from [−1, 1] to [0, 1]"
             .into();
         story.unclipped = colour.to_array();
-        story.colour = colour.to_array();
+        story.colour = colour.clamp(Vec3::ZERO, Vec3::ONE).to_array();
         return story;
     }
     let segments = if settings.stages.reflection {
@@ -465,10 +466,6 @@ fn vec3(v: [f64; 3]) -> String {
     vector(Vec3::from_array(v))
 }
 
-fn byte(v: f64) -> u8 {
-    (v.clamp(0.0, 1.0) as f32 * 255.0).round() as u8
-}
-
 impl std::fmt::Display for Explanation {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(
@@ -602,9 +599,9 @@ impl std::fmt::Display for Explanation {
             "colour: {} → clipped to [0, 1]: {} → 8-bit ({}, {}, {})",
             vec3(self.unclipped),
             vec3(self.colour),
-            byte(self.colour[0]),
-            byte(self.colour[1]),
-            byte(self.colour[2])
+            to_byte(self.colour[0] as f32),
+            to_byte(self.colour[1] as f32),
+            to_byte(self.colour[2] as f32)
         )?;
         if let Some(s) = &self.samples {
             writeln!(

@@ -30,19 +30,12 @@ pub fn write_frame(frame: &Frame, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     Ok(paths)
 }
 
-/// Write several files, all or none (see [`Pending`]).
-pub fn write_all_atomically(files: &[(PathBuf, Vec<u8>)]) -> Result<(), Error> {
-    let mut pending = Pending::new();
-    for (path, bytes) in files {
-        pending.file(path, bytes)?;
-    }
-    pending.commit()
-}
-
 /// Write `bytes` to `path` through a temporary file in the same folder, renamed
-/// into place once complete.
+/// into place once complete (see [`Pending`]).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    write_all_atomically(&[(path.to_path_buf(), bytes.to_vec())])
+    let mut pending = Pending::new();
+    pending.file(path, bytes)?;
+    pending.commit()
 }
 
 /// Output files written under temporary names, waiting to be renamed into place
@@ -345,7 +338,7 @@ fn miss_colour(row: usize, col: usize) -> [f32; 3] {
     }
 }
 
-fn to_byte(v: f32) -> u8 {
+pub(crate) fn to_byte(v: f32) -> u8 {
     (v.clamp(0.0, 1.0) * 255.0).round() as u8
 }
 // ANCHOR_END: visualise

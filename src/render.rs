@@ -246,7 +246,7 @@ impl<T: Real> Tracer<T> {
         let ray = self.camera.primary_ray::<T>(row, col);
         if !self.stages.intersection {
             // Clipped like every colour: rounding can leave a component just past ±1.
-            let colour = ((ray.direction.to_f64() + Vec3::ONE) * 0.5).clamp(Vec3::ZERO, Vec3::ONE);
+            let colour = direction_colour(ray.direction.to_f64()).clamp(Vec3::ZERO, Vec3::ONE);
             let rays = Rays {
                 primary: 1,
                 ..Rays::default()
@@ -461,6 +461,12 @@ pub fn splitmix64(x: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
+}
+
+/// The colour of the `rays` stage: each component of a unit `direction` mapped
+/// from [−1, 1] to [0, 1] (before clipping).
+pub fn direction_colour(direction: Vec3) -> Vec3 {
+    (direction + Vec3::ONE) * 0.5
 }
 
 // ANCHOR: render

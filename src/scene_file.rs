@@ -183,20 +183,17 @@ const SECTIONS: [(&str, &[&str]); 7] = [
 /// characters around it (a file may be one huge line).
 fn toml_error(e: &toml::de::Error, text: &str) -> String {
     let what = plain_types(e.message().trim_end());
+    let with_hint = |what: String| match hint(&what) {
+        Some(h) => format!("{what}; {h}"),
+        None => what,
+    };
     let Some(span) = e.span() else {
-        let hint = hint(&what).map(|h| format!("; {h}")).unwrap_or_default();
-        return format!("{what}{hint}");
+        return with_hint(what);
     };
     let start = span.start.min(text.len());
     let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
     let line_end = text[start..].find('\n').map_or(text.len(), |i| start + i);
-    let (what, hint) = match brackets(&what, &text[line_start..line_end]) {
-        Some(instead) => (instead, String::new()),
-        None => {
-            let hint = hint(&what).map(|h| format!("; {h}")).unwrap_or_default();
-            (what, hint)
-        }
-    };
+    let what = brackets(&what, &text[line_start..line_end]).unwrap_or_else(|| with_hint(what));
     let line = text[..start].matches('\n').count() + 1;
     let chars: Vec<char> = text[line_start..line_end]
         .trim_end_matches('\r')
@@ -221,7 +218,7 @@ fn toml_error(e: &toml::de::Error, text: &str) -> String {
     let pad = " ".repeat(column - from + dots_before.chars().count());
     let marks = "^".repeat(width.min(to.saturating_sub(column)).max(1));
     format!(
-        "line {line}, column {}: {what}{hint}\n{gutter} |\n{line} | {dots_before}{shown}{dots_after}\n{gutter} | {pad}{marks}",
+        "line {line}, column {}: {what}\n{gutter} |\n{line} | {dots_before}{shown}{dots_after}\n{gutter} | {pad}{marks}",
         column + 1
     )
 }
@@ -526,7 +523,7 @@ impl SceneFile {
         .map(f64::abs)
         .into_iter()
         .fold(0.0, f64::max);
-        let nearest = (MIN_RADIUS_RATIO * size).max(MIN_RADIUS);
+        let nearest = least_length(size);
         if camera.z.abs() < nearest {
             return Err(format!(
                 "camera.position: z = {} puts the eye too near the screen, which lies in the \
@@ -708,6 +705,13 @@ fn colour(value: Option<Triple>, default: Vec3, key: &str) -> Result<Vec3, Strin
     Ok(c)
 }
 
+/// The least length (a radius, the camera's distance from the screen) that float32
+/// resolves among coordinates up to `size`: [`MIN_RADIUS_RATIO`] of it, and at least
+/// [`MIN_RADIUS`].
+fn least_length(size: f64) -> f64 {
+    (MIN_RADIUS_RATIO * size).max(MIN_RADIUS)
+}
+
 /// Refuse a sphere too small for its place in the scene, and a camera or a light
 /// inside (or on) it.
 ///
@@ -721,7 +725,7 @@ fn colour(value: Option<Triple>, default: Vec3, key: &str) -> Result<Vec3, Strin
 ///   [`MIN_RADIUS_RATIO`] of the scene's size of the surface.
 fn placed(s: &Sphere, at: &str, camera: Vec3, light: Vec3) -> Result<(), String> {
     let size = s.center.abs().max_element().max(camera.abs().max_element());
-    let smallest = (MIN_RADIUS_RATIO * size).max(MIN_RADIUS);
+    let smallest = least_length(size);
     if s.radius < smallest {
         return Err(format!(
             "{at}, radius: {} is smaller than {}, the least raystep accepts here \

@@ -82,40 +82,41 @@ fn check_output(what: &str, out: &Output, expected: &Expected) {
     }
 }
 
-/// Every file in `dir` (hidden ones too, and in sub-folders), with its bytes.
-fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut found = BTreeMap::new();
+/// Every path under `dir` (hidden ones too, folders included, and what is in
+/// them), relative to `dir`, sorted.
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
     let mut folders = vec![dir.to_path_buf()];
     while let Some(folder) = folders.pop() {
         for entry in std::fs::read_dir(&folder).unwrap() {
             let path = entry.unwrap().path();
             if path.is_dir() {
-                folders.push(path);
-            } else {
-                let name = path.strip_prefix(dir).unwrap().display().to_string();
-                found.insert(name, std::fs::read(&path).unwrap());
+                folders.push(path.clone());
             }
-        }
-    }
-    found
-}
-
-/// Every name under `dir`, folders included.
-fn names(dir: &Path) -> Vec<String> {
-    let mut found = Vec::new();
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        found.push(path.strip_prefix(dir).unwrap().display().to_string());
-        if path.is_dir() {
-            found.extend(
-                names(&path)
-                    .into_iter()
-                    .map(|n| format!("{}/{n}", path.file_name().unwrap().to_string_lossy())),
-            );
+            found.push(path.strip_prefix(dir).unwrap().to_path_buf());
         }
     }
     found.sort();
     found
+}
+
+/// Every file under `dir`, with its bytes.
+fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    walk(dir)
+        .into_iter()
+        .filter(|p| dir.join(p).is_file())
+        .map(|p| {
+            (
+                p.display().to_string(),
+                std::fs::read(dir.join(&p)).unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// Every name under `dir`, folders included.
+fn names(dir: &Path) -> Vec<String> {
+    walk(dir).iter().map(|p| p.display().to_string()).collect()
 }
 
 /// The scene files of the corpus, sorted by name.
