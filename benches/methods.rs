@@ -75,6 +75,17 @@ fn figure_1(bencher: Bencher, config: usize) {
     bencher.bench(|| render(&scene, &settings, &|_| {}));
 }
 
+/// Figure 1 with the defaults, one ray at a time against four at once.
+#[divan::bench(args = ["one ray", "packets"], sample_count = 60)]
+fn packets(bencher: Bencher, how: &str) {
+    let scene = seed();
+    let settings = Settings {
+        packets: how == "packets",
+        ..Settings::from(Stages::ALL)
+    };
+    bencher.bench(|| render(&scene, &settings, &|_| {}));
+}
+
 #[divan::bench(args = ["fake", "true"], sample_count = 60)]
 fn floor(bencher: Bencher, kind: &str) {
     let scene = match kind {

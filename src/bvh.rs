@@ -19,6 +19,7 @@
 //! renders both ways and compares the bytes). Boxes are computed in float64 and
 //! widened by a relative 1e-9, far more than their rounding.
 
+use crate::lanes::{Lanes, V3};
 use crate::ray::Ray;
 use crate::real::{Real, Vector};
 use crate::scene::{consider, Hit, Object, Role, Shape};
@@ -46,6 +47,9 @@ pub struct Bvh {
     nodes: Vec<Node>,
     /// Object indices, leaf by leaf.
     items: Vec<u32>,
+    /// The centre and radius of each sphere of `items`, in the same order, so
+    /// that a leaf's spheres sit side by side in memory (for packets).
+    balls: Vec<[f64; 4]>,
     /// Objects outside the tree, tested for every ray.
     loose: Vec<u32>,
 }
@@ -57,6 +61,7 @@ struct Item {
     min: Vec3,
     max: Vec3,
     centre: Vec3,
+    radius: f64,
 }
 
 impl Bvh {
@@ -81,6 +86,7 @@ impl Bvh {
                         min: c - half,
                         max: c + half,
                         centre: c,
+                        radius: r,
                     });
                 }
                 _ => loose.push(i as u32),
@@ -89,6 +95,7 @@ impl Bvh {
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(2 * items.len() / LEAF + 1),
             items: Vec::with_capacity(items.len()),
+            balls: Vec::with_capacity(items.len()),
             loose,
         };
         if !items.is_empty() {
@@ -114,6 +121,8 @@ impl Bvh {
         });
         if items.len() <= LEAF {
             self.items.extend(items.iter().map(|i| i.index));
+            let ball = |i: &Item| [i.centre.x, i.centre.y, i.centre.z, i.radius];
+            self.balls.extend(items.iter().map(ball));
             return at;
         }
         let spread = high - low;
@@ -147,6 +156,7 @@ impl Bvh {
     pub fn bytes(&self) -> usize {
         self.nodes.capacity() * std::mem::size_of::<Node>()
             + (self.items.capacity() + self.loose.capacity()) * 4
+            + self.balls.capacity() * std::mem::size_of::<[f64; 4]>()
     }
 
     // ANCHOR: enter
@@ -298,6 +308,110 @@ impl Bvh {
             }
             depth -= 1;
             node = stack[depth] as usize;
+        }
+    }
+}
+
+/// Four numbers of float64, the lanes of a packet's box tests.
+type F64s = <f64 as Real>::Lanes;
+
+/// What a packet's walk through the tree asks of its rays ([`Bvh::search_packet`]).
+pub trait PacketSearch {
+    /// The lanes still searching (none: the walk stops), and for each lane the
+    /// distance beyond which a box need not be entered.
+    fn limits(&self) -> (u32, F64s);
+    /// Test object `index` against the rays.
+    fn test(&mut self, index: usize);
+    /// Test object `index`, a sphere of centre `ball[0..3]` and radius `ball[3]`.
+    fn test_sphere(&mut self, index: usize, ball: &[f64; 4]);
+}
+
+impl Bvh {
+    /// [`Bvh::enter`] for four rays at once: where each enters the box of `node`,
+    /// and the lanes that enter it before their limit.
+    #[inline(always)]
+    fn enter_packet(node: &Node, origin: &V3<f64>, inverse: &V3<f64>, limit: F64s) -> (F64s, u32) {
+        let slab = |min: f64, max: f64, o: F64s, inv: F64s| {
+            let t1 = (F64s::splat(min) - o) * inv;
+            let t2 = (F64s::splat(max) - o) * inv;
+            (t1.min(t2), t1.max(t2))
+        };
+        let (nx, fx) = slab(node.min.x, node.max.x, origin.x, inverse.x);
+        let (ny, fy) = slab(node.min.y, node.max.y, origin.y, inverse.y);
+        let (nz, fz) = slab(node.min.z, node.max.z, origin.z, inverse.z);
+        let near = nx.max(ny).max(nz).max(F64s::splat(0.0));
+        let far = fx.min(fy).min(fz);
+        (near, (far.ge(near) & limit.ge(near)).bits())
+    }
+
+    /// Walk the tree with four rays from `origin` along directions whose
+    /// reciprocals are `inverse` (in float64, as [`Bvh::nearest_hit`] computes
+    /// them): every object outside the tree, then every object of every leaf whose
+    /// box some lane still searching enters before its limit. A lane's result is
+    /// the one-ray walk's, because a lane skips only boxes that cannot hold a hit
+    /// as near as its limit; objects it did not need are tested too, and cannot
+    /// come nearer. Children are visited nearer first for the lowest lane that
+    /// enters both (the first child first if no lane enters both).
+    pub fn search_packet(
+        &self,
+        origin: &V3<f64>,
+        inverse: &V3<f64>,
+        search: &mut impl PacketSearch,
+    ) {
+        for &i in &self.loose {
+            search.test(i as usize);
+        }
+        if self.nodes.is_empty() {
+            return;
+        }
+        let enters = |node: usize, (active, limit): (u32, F64s)| {
+            let (near, bits) = Self::enter_packet(&self.nodes[node], origin, inverse, limit);
+            (near, bits & active)
+        };
+        if enters(0, search.limits()).1 == 0 {
+            return;
+        }
+        let mut stack = [0u32; 64];
+        let mut depth = 0;
+        let mut node = 0usize;
+        loop {
+            let n = self.nodes[node];
+            if n.count > 0 {
+                for k in n.first as usize..(n.first + n.count) as usize {
+                    search.test_sphere(self.items[k] as usize, &self.balls[k]);
+                }
+            } else {
+                let (a, b) = (node + 1, n.first as usize);
+                let limits = search.limits();
+                let (ta, ma) = enters(a, limits);
+                let (tb, mb) = enters(b, limits);
+                if ma != 0 && mb != 0 {
+                    let both = ma & mb;
+                    let lane = both.trailing_zeros() as usize;
+                    let a_first = both == 0 || ta.to_array()[lane] <= tb.to_array()[lane];
+                    let (near, far) = if a_first { (a, b) } else { (b, a) };
+                    stack[depth] = far as u32;
+                    depth += 1;
+                    node = near;
+                    continue;
+                }
+                if ma != 0 || mb != 0 {
+                    node = if ma != 0 { a } else { b };
+                    continue;
+                }
+            }
+            // Next from the stack, skipping boxes no lane still needs.
+            loop {
+                if depth == 0 {
+                    return;
+                }
+                depth -= 1;
+                let candidate = stack[depth] as usize;
+                if enters(candidate, search.limits()).1 != 0 {
+                    node = candidate;
+                    break;
+                }
+            }
         }
     }
 }

@@ -96,6 +96,7 @@ fn configs(max_depth: u32) -> Vec<Config> {
         with("naive", &|s| s.method = Method::Naive),
         with("fixed:1e-5", &|s| s.offset = Offset::TUTORIAL),
         with("accel off", &|s| s.accel = Accel::Off),
+        with("packets off", &|s| s.packets = false),
         with("early stop off", &|s| s.early_stop = false),
         with("spp 4", &|s| s.spp = 4),
         with("spp 16", &|s| s.spp = 16),
@@ -545,8 +546,9 @@ fn draw_scale<DB: DrawingBackend>(
         ),
         0,
     )?;
+    let auto = format!("--accel auto (BVH from {} spheres)", crate::accel::BVH_FROM);
     for (accel, colour, name) in [
-        (Accel::Auto, BLUE, "--accel auto (BVH from 12 spheres)"),
+        (Accel::Auto, BLUE, auto.as_str()),
         (
             Accel::Off,
             RGBColor(200, 30, 30),

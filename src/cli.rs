@@ -240,9 +240,13 @@ pub struct RuleArgs {
     pub early_stop: Option<Switch>,
     /// How the nearest hit is searched for; never changes a pixel: off (the plain
     /// loop over every object), auto (tile masks for primary rays, and a BVH from
-    /// 12 spheres on), bvh (always a BVH) [default: auto].
+    /// 24 spheres on), bvh (always a BVH) [default: auto].
     #[arg(long, value_enum)]
     pub accel: Option<Accel>,
+    /// Trace four neighbouring pixels at once, in SIMD lanes; never changes a
+    /// pixel (scenes with a BVH trace one ray at a time) [default: on].
+    #[arg(long, value_enum, value_name = "on|off")]
+    pub packets: Option<Switch>,
 }
 
 /// On or off.
@@ -383,6 +387,7 @@ impl RuleArgs {
             accel: self.accel.unwrap_or(base.accel),
             spp: self.spp.unwrap_or(base.spp),
             early_stop: self.early_stop.map_or(base.early_stop, |s| s == Switch::On),
+            packets: self.packets.map_or(base.packets, |s| s == Switch::On),
         })
     }
 }

@@ -42,9 +42,11 @@ pub mod output;
 pub mod page;
 pub mod render;
 pub mod stages;
-// Speed: skipping tests that cannot succeed.
+// Speed: skipping tests that cannot succeed, and four rays at once.
 pub mod accel;
 pub mod bvh;
+pub mod lanes;
+pub mod packet;
 // The command line, its errors, and the tools around the renderer.
 pub mod accuracy;
 pub mod bench;

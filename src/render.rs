@@ -9,6 +9,8 @@ use crate::accel::{Accel, TileMasks, BVH_FROM, EVERY};
 use crate::aov::{FirstHit, Frame, PixelRecord};
 use crate::bvh::Bvh;
 use crate::camera::Camera;
+use crate::lanes::WIDTH;
+use crate::packet::Packed;
 use crate::ray::Ray;
 use crate::real::{Precision, Real, Vector};
 use crate::scene::{consider, nearest_hit, Hit, Light, Object, Role, Scene};
@@ -43,6 +45,9 @@ pub struct Settings {
     /// an 8-bit step, so a pixel by at most one level (`--early-stop`; default on,
     /// tutorial off).
     pub early_stop: bool,
+    /// Trace four neighbouring pixels at once in SIMD lanes (`--packets`; never
+    /// changes a pixel; default on).
+    pub packets: bool,
 }
 
 impl From<Stages> for Settings {
@@ -56,6 +61,7 @@ impl From<Stages> for Settings {
             accel: Accel::default(),
             spp: 1,
             early_stop: true,
+            packets: true,
         }
     }
 }
@@ -73,6 +79,7 @@ impl Settings {
             accel: Accel::default(),
             spp: 1,
             early_stop: false,
+            packets: true,
         }
     }
 }
@@ -105,6 +112,12 @@ pub struct Tracer<T: Real = f64> {
     /// With early stop on, `reach[k]`: the most that `k` more segments of weight 1
     /// can add to a channel; empty with early stop off.
     pub reach: Vec<f64>,
+    /// Trace four pixels at once ([`Settings::packets`]; without a BVH only for
+    /// up to [`crate::packet::MAX_OBJECTS`] objects).
+    pub packets: bool,
+    /// The objects as the packet tracer reads them; empty without packets or with
+    /// a BVH.
+    pub packed: Vec<crate::packet::Packed<T>>,
 }
 
 /// Half an 8-bit step: a path whose remaining segments cannot add this much to
@@ -174,6 +187,15 @@ impl<T: Real> Tracer<T> {
             Accel::Off => TileMasks::none(),
             Accel::Auto | Accel::Bvh => TileMasks::new(&camera, &objects),
         };
+        let light: Light<T> = scene.light.cast();
+        // Packets search a short list by bit masks, a long one through the BVH.
+        let packets =
+            settings.packets && (bvh.is_some() || objects.len() <= crate::packet::MAX_OBJECTS);
+        let packed = if packets && bvh.is_none() {
+            objects.iter().map(|o| Packed::new(o, &light)).collect()
+        } else {
+            Vec::new()
+        };
         let reach = if settings.early_stop {
             reach(&objects, &scene.light, scene.max_depth, settings.stages)
         } else {
@@ -186,12 +208,14 @@ impl<T: Real> Tracer<T> {
             viewer: settings.viewer,
             camera,
             objects,
-            light: scene.light.cast(),
+            light,
             max_depth: scene.max_depth,
             spp: settings.spp,
             masks,
             bvh,
             reach,
+            packets,
+            packed,
         }
     }
 
@@ -515,10 +539,16 @@ fn render_in<T: Real>(
             if crate::interrupt::requested() {
                 return rays; // Ctrl-C: the rest is skipped, and the frame thrown away
             }
-            for (col, pixel) in line.iter_mut().enumerate() {
-                let (record, taken) = tracer.pixel(row as u32, col as u32);
-                *pixel = record;
-                rays += taken;
+            if tracer.packets {
+                for (k, pixels) in line.chunks_mut(WIDTH).enumerate() {
+                    rays += tracer.pixel_packet(row as u32, (k * WIDTH) as u32, pixels);
+                }
+            } else {
+                for (col, pixel) in line.iter_mut().enumerate() {
+                    let (record, taken) = tracer.pixel(row as u32, col as u32);
+                    *pixel = record;
+                    rays += taken;
+                }
             }
             progress(1);
             rays

@@ -412,7 +412,7 @@ fn the_charts_shown_exist_and_their_numbers_are_the_csv_files() {
         );
     }
     for command in [
-        "raystep chart --out chapters/charts",
+        "raystep chart --runs 15 --out chapters/charts",
         "raystep chart --scale --runs 3 --out chapters/charts",
     ] {
         assert!(text.contains(command), "chapter 10 shows `{command}`");
@@ -430,6 +430,7 @@ fn the_charts_shown_exist_and_their_numbers_are_the_csv_files() {
     assert!(rmse("f32") > 2.0 * rmse("default") - 0.1);
     assert_eq!(rmse("naive"), rmse("default"));
     assert_eq!(rmse("accel off"), rmse("default"));
+    assert_eq!(rmse("packets off"), rmse("default"));
     assert_eq!(rmse("early stop off"), rmse("default"));
 }
 

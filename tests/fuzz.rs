@@ -11,7 +11,7 @@
 //!   another; a number replaced by a hostile one (`nan`, `inf`, `5e-324`, `1e16`,
 //!   `"x"`, `[1,2]`, …) or multiplied by a power of ten; a key misspelt; a
 //!   `[[sphere]]` or `[[plane]]` block copied (up to 66 times, past the BVH's
-//!   threshold of 12 spheres and the tile masks' 64 objects); a table header
+//!   threshold of 24 spheres and the tile masks' and packets' 64 objects); a table header
 //!   dropped. It is parsed at a small size, or at the file's own.
 //! - `random_scenes_at_extreme_scales_render_sound_pixels` writes valid scenes as
 //!   TOML text at a scale of 10^k, k from −6 to 12: a camera, a light, one to
@@ -152,9 +152,10 @@ fn any_settings() -> impl Strategy<Value = Settings> {
         prop::sample::select(vec![Accel::Off, Accel::Auto, Accel::Bvh]),
         prop::sample::select(vec![1u32, 4, 9]),
         any::<bool>(),
+        any::<bool>(),
     )
         .prop_map(
-            |(last, without, f32, method, offset, viewer, accel, spp, early_stop)| {
+            |(last, without, f32, method, offset, viewer, accel, spp, early_stop, packets)| {
                 // `--stage last --without ...`, or all up to `last` if that set is refused.
                 let stages = Stages::select(last, &without).unwrap_or(Stages::up_to(last));
                 Settings {
@@ -165,6 +166,7 @@ fn any_settings() -> impl Strategy<Value = Settings> {
                     accel,
                     spp,
                     early_stop,
+                    packets,
                     ..Settings::from(stages)
                 }
             },
@@ -221,20 +223,22 @@ fn renders_soundly(scene: &Scene, settings: &[(&str, Settings)]) -> Result<(), S
                 ));
             }
         }
-        // Acceleration skips only tests that cannot succeed: the plain loop over
-        // every object must give the very same records.
-        if s.accel != Accel::Off {
+        // Acceleration skips only tests that cannot succeed, and packets compute
+        // the same numbers four at a time: the book's plain loop over every object,
+        // one ray at a time, must give the very same records.
+        if s.accel != Accel::Off || s.packets {
             let plain = render(
                 scene,
                 &Settings {
                     accel: Accel::Off,
+                    packets: false,
                     ..*s
                 },
                 &|_| {},
             );
             if let Some(i) = (0..frame.pixels.len()).find(|&i| frame.pixels[i] != plain.pixels[i]) {
                 return Err(format!(
-                    "{name} ({s:?}): pixel (row {}, col {}) differs with --accel off: {:?} against {:?}",
+                    "{name} ({s:?}): pixel (row {}, col {}) differs with --accel off --packets off: {:?} against {:?}",
                     i / width,
                     i % width,
                     frame.pixels[i],

@@ -9,7 +9,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use raystep::accel::Accel;
-use raystep::aov::Frame;
+use raystep::aov::{Frame, PixelRecord};
 use raystep::real::Precision;
 use raystep::render::{render, stratified, Rays, Settings, Tracer};
 use raystep::scene::Scene;
@@ -86,6 +86,141 @@ fn tile_masks_and_the_bvh_change_no_pixel_of_any_scene() {
                     frame.pixels == frames[0].pixels && frame.rays == frames[0].rays,
                     "{name}: --accel {accel} differs from the plain loop ({:?})",
                     base.method
+                );
+            }
+        }
+    }
+}
+
+/// Every bit of every record, so that even a zero of the other sign is a difference.
+fn bits(frame: &Frame) -> Vec<[u32; 12]> {
+    frame
+        .pixels
+        .iter()
+        .map(|p| {
+            let f = |x: f32| x.to_bits();
+            [
+                f(p.colour[0]),
+                f(p.colour[1]),
+                f(p.colour[2]),
+                f(p.depth),
+                f(p.normal[0]),
+                f(p.normal[1]),
+                f(p.normal[2]),
+                f(p.shadow),
+                p.object,
+                f(p.diffuse) ^ f(p.specular).rotate_left(16),
+                p.bounces,
+                p.rays,
+            ]
+        })
+        .collect()
+}
+
+/// The settings the packet tracer must agree with the scalar one under: every
+/// stage alone and in turn, the tutorial's rules, both precisions, both methods,
+/// both offsets (and none at all), both viewers, samples, early stop off, the
+/// plain loop and the BVH.
+fn packet_settings() -> Vec<(String, Settings)> {
+    use raystep::shade::blinn_phong::Viewer;
+    use raystep::shade::shadow::Offset;
+    use raystep::stages::Stage;
+    let all = Settings::from(Stages::ALL);
+    let mut list: Vec<(String, Settings)> = Stage::ALL
+        .into_iter()
+        .map(|s| (format!("up to {s:?}"), Settings::from(Stages::up_to(s))))
+        .collect();
+    for without in [Stage::Shadow, Stage::BlinnPhong] {
+        let stages = Stages::select(Stage::Plane, &[without]).unwrap();
+        list.push((format!("without {without:?}"), Settings::from(stages)));
+    }
+    let f32 = Settings {
+        precision: Precision::F32,
+        ..all
+    };
+    list.extend([
+        ("tutorial".into(), Settings::tutorial(Stages::ALL)),
+        ("f32".into(), f32),
+        (
+            "f32 tutorial".into(),
+            Settings {
+                precision: Precision::F32,
+                ..Settings::tutorial(Stages::ALL)
+            },
+        ),
+        (
+            "f32 fixed:0".into(),
+            Settings {
+                offset: Offset::Fixed(0.0),
+                ..f32
+            },
+        ),
+        (
+            "naive auto".into(),
+            Settings {
+                method: Method::Naive,
+                ..all
+            },
+        ),
+        (
+            "viewer ray-origin".into(),
+            Settings {
+                viewer: Viewer::RayOrigin,
+                ..all
+            },
+        ),
+        ("spp 4".into(), Settings { spp: 4, ..all }),
+        (
+            "early stop off".into(),
+            Settings {
+                early_stop: false,
+                ..all
+            },
+        ),
+        (
+            "accel off".into(),
+            Settings {
+                accel: Accel::Off,
+                ..all
+            },
+        ),
+        (
+            "accel bvh".into(),
+            Settings {
+                accel: Accel::Bvh,
+                ..all
+            },
+        ),
+    ]);
+    list
+}
+
+#[test]
+fn packets_change_no_bit_of_any_record_of_any_scene() {
+    for (name, mut scene) in scenes() {
+        // Odd sizes, so that the last packet of a row is a partial one.
+        (scene.width, scene.height) = (61, 37);
+        for (what, settings) in packet_settings() {
+            let one = |packets| {
+                render(
+                    &scene,
+                    &Settings {
+                        packets,
+                        ..settings
+                    },
+                    &|_| {},
+                )
+            };
+            let (scalar, packets) = (one(false), one(true));
+            assert_eq!(scalar.rays, packets.rays, "{name}, {what}: ray counts");
+            let (a, b) = (bits(&scalar), bits(&packets));
+            if let Some(i) = (0..a.len()).find(|&i| a[i] != b[i]) {
+                panic!(
+                    "{name}, {what}: pixel ({}, {}) differs: {:?} against the scalar {:?}",
+                    i / 61,
+                    i % 61,
+                    packets.pixels[i],
+                    scalar.pixels[i]
                 );
             }
         }
@@ -302,15 +437,24 @@ fn the_pixel_loop_allocates_nothing() {
         (many, Settings::from(Stages::ALL)),
     ] {
         let tracer = Tracer::<f64>::new(&scene, &settings);
+        let mut line = vec![PixelRecord::new(Default::default(), None, 0, 0); 4];
         COUNTING.with(|c| c.set(true));
-        let mut sum = 0.0;
+        let (mut sum, mut packed) = (0.0, 0.0);
         for row in 0..scene.height {
             for col in 0..scene.width {
                 sum += tracer.pixel(row, col).0.colour[0];
             }
+            // The packet loop, where the scene has one (no BVH).
+            if tracer.packets {
+                for col in (0..scene.width).step_by(4) {
+                    tracer.pixel_packet(row, col, &mut line);
+                    packed += line.iter().map(|p| p.colour[0]).sum::<f32>();
+                }
+            }
         }
         COUNTING.with(|c| c.set(false));
         assert!(sum > 0.0);
+        assert!(!tracer.packets || packed > 0.0);
         assert_eq!(
             ALLOCATIONS.with(Cell::get),
             0,

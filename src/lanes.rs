@@ -1,0 +1,390 @@
+//! Four numbers at once: the SIMD lanes the [packet tracer](crate::packet)
+//! computes in.
+//!
+//! [`Lanes`] is to four rays what [`Real`] is to one: the few operations the
+//! packet tracer needs, for float64 (wide's `f64x4`, two SSE2 registers on a plain
+//! x86-64 build) and float32 (`f32x4`, one). [`V3`] is a 3-vector whose components
+//! are lanes: four vectors side by side.
+//!
+//! Every operation here is the IEEE one, rounded once, exactly as the scalar
+//! operation is, and every formula of [`V3`] adds and multiplies in the order glam
+//! does. So each lane computes, bit for bit, what the scalar tracer computes for
+//! its ray. (That rules out fused multiply-add, which rounds once where the scalar
+//! code rounds twice.)
+//!
+//! A comparison gives a *mask*: a value of the same type whose lanes have every
+//! bit set (true) or none (false). [`Lanes::bits`] turns it into a 4-bit number for
+//! the control flow, [`Lanes::select`] picks lane by lane.
+
+use std::fmt::Debug;
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+use crate::real::{Real, Vector};
+
+/// The number of lanes: rays traced together.
+pub const WIDTH: usize = 4;
+
+/// The bits of every lane.
+pub const ALL: u32 = (1 << WIDTH) - 1;
+
+/// Four numbers of precision `T` computed together.
+pub trait Lanes<T: Real>:
+    Copy
+    + Debug
+    + Send
+    + Sync
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + BitAnd<Output = Self>
+    + BitOr<Output = Self>
+    + Not<Output = Self>
+{
+    /// The same number in every lane.
+    fn splat(x: T) -> Self;
+    /// Lane `i` from `a[i]`.
+    fn from_array(a: [T; WIDTH]) -> Self;
+    /// The lanes as an array.
+    fn to_array(self) -> [T; WIDTH];
+    /// Square root of each lane.
+    fn sqrt(self) -> Self;
+    /// The smaller of two, lane by lane (as [`Real::min`]: a NaN gives the other).
+    fn min(self, other: Self) -> Self;
+    /// The larger of two, lane by lane (as [`Real::max`]: a NaN gives the other).
+    fn max(self, other: Self) -> Self;
+    /// Absolute value of each lane.
+    fn abs(self) -> Self;
+    /// Mask of `self > other`.
+    fn gt(self, other: Self) -> Self;
+    /// Mask of `self < other`.
+    fn lt(self, other: Self) -> Self;
+    /// Mask of `self >= other`.
+    fn ge(self, other: Self) -> Self;
+    /// Mask of `self != other` (true for a NaN).
+    fn ne(self, other: Self) -> Self;
+    /// Where the mask `self` is true, `yes`; elsewhere `no`.
+    fn select(self, yes: Self, no: Self) -> Self;
+    /// Bit `i` set where lane `i` of the mask `self` is true.
+    fn bits(self) -> u32;
+    /// The mask whose lane `i` is true where bit `i` of `bits` is set.
+    fn mask(bits: u32) -> Self;
+}
+
+macro_rules! lanes {
+    ($t:ty, $w:ty, $bits:ty) => {
+        impl Lanes<$t> for $w {
+            #[inline(always)]
+            fn splat(x: $t) -> Self {
+                <$w>::splat(x)
+            }
+            #[inline(always)]
+            fn from_array(a: [$t; WIDTH]) -> Self {
+                <$w>::new(a)
+            }
+            #[inline(always)]
+            fn to_array(self) -> [$t; WIDTH] {
+                <$w>::to_array(self)
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                <$w>::sqrt(self)
+            }
+            #[inline(always)]
+            fn min(self, other: Self) -> Self {
+                <$w>::min(self, other)
+            }
+            #[inline(always)]
+            fn max(self, other: Self) -> Self {
+                <$w>::max(self, other)
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                <$w>::abs(self)
+            }
+            #[inline(always)]
+            fn gt(self, other: Self) -> Self {
+                self.simd_gt(other)
+            }
+            #[inline(always)]
+            fn lt(self, other: Self) -> Self {
+                self.simd_lt(other)
+            }
+            #[inline(always)]
+            fn ge(self, other: Self) -> Self {
+                self.simd_ge(other)
+            }
+            #[inline(always)]
+            fn ne(self, other: Self) -> Self {
+                self.simd_ne(other)
+            }
+            #[inline(always)]
+            fn select(self, yes: Self, no: Self) -> Self {
+                <$w>::select(self, yes, no)
+            }
+            #[inline(always)]
+            fn bits(self) -> u32 {
+                self.to_bitmask()
+            }
+            #[inline(always)]
+            fn mask(bits: u32) -> Self {
+                let lane =
+                    |i: usize| <$t>::from_bits(if bits >> i & 1 == 1 { <$bits>::MAX } else { 0 });
+                <$w>::new([lane(0), lane(1), lane(2), lane(3)])
+            }
+        }
+    };
+}
+
+lanes!(f64, wide::f64x4, u64);
+lanes!(f32, wide::f32x4, u32);
+
+/// A 3-vector of lanes of precision `T`: lane `i` of `x`, `y` and `z` is vector `i`.
+#[derive(Clone, Copy, Debug)]
+pub struct V3<T: Real> {
+    /// The x components.
+    pub x: T::Lanes,
+    /// The y components.
+    pub y: T::Lanes,
+    /// The z components.
+    pub z: T::Lanes,
+}
+
+impl<T: Real> V3<T> {
+    /// The vector of lanes from its three components.
+    #[inline(always)]
+    pub fn new(x: T::Lanes, y: T::Lanes, z: T::Lanes) -> V3<T> {
+        V3 { x, y, z }
+    }
+
+    /// The same vector `v` in every lane.
+    #[inline(always)]
+    pub fn splat(v: T::Vec3) -> V3<T> {
+        let [x, y, z] = components::<T>(v);
+        V3::new(T::Lanes::splat(x), T::Lanes::splat(y), T::Lanes::splat(z))
+    }
+
+    /// Vector `i` in lane `i`.
+    #[inline(always)]
+    pub fn from_vectors(v: [T::Vec3; WIDTH]) -> V3<T> {
+        let c = v.map(components::<T>);
+        V3::new(
+            T::Lanes::from_array(c.map(|c| c[0])),
+            T::Lanes::from_array(c.map(|c| c[1])),
+            T::Lanes::from_array(c.map(|c| c[2])),
+        )
+    }
+
+    /// The vector in lane `i`, for each lane.
+    #[inline(always)]
+    pub fn to_vectors(self) -> [T::Vec3; WIDTH] {
+        let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
+        std::array::from_fn(|i| T::Vec3::new(x[i], y[i], z[i]))
+    }
+
+    /// Dot product, lane by lane: `x·x' + y·y' + z·z'`, added in that order.
+    #[inline(always)]
+    pub fn dot(self, o: V3<T>) -> T::Lanes {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// Squared length.
+    #[inline(always)]
+    pub fn length_squared(self) -> T::Lanes {
+        self.dot(self)
+    }
+
+    /// Euclidean length.
+    #[inline(always)]
+    pub fn length(self) -> T::Lanes {
+        self.dot(self).sqrt()
+    }
+
+    /// The unit vector in the same direction: `v · (1 / ‖v‖)`, as glam computes it.
+    #[inline(always)]
+    pub fn normalize(self) -> V3<T> {
+        let recip = T::Lanes::splat(T::of(1.0)) / self.length();
+        self.scale(recip)
+    }
+
+    /// The largest absolute value of a component, as glam's `abs().max_element()`.
+    #[inline(always)]
+    pub fn max_abs(self) -> T::Lanes {
+        let max = |a: T::Lanes, b: T::Lanes| a.gt(b).select(a, b);
+        max(self.x.abs(), max(self.y.abs(), self.z.abs()))
+    }
+
+    /// Where the mask `m` is true, `yes`; elsewhere `no`.
+    #[inline(always)]
+    pub fn select(m: T::Lanes, yes: V3<T>, no: V3<T>) -> V3<T> {
+        V3::new(
+            m.select(yes.x, no.x),
+            m.select(yes.y, no.y),
+            m.select(yes.z, no.z),
+        )
+    }
+}
+
+/// The three components of a vector (exactly: through float64 and back).
+#[inline(always)]
+pub fn components<T: Real>(v: T::Vec3) -> [T; 3] {
+    let d = v.to_f64();
+    [T::of(d.x), T::of(d.y), T::of(d.z)]
+}
+
+impl<T: Real> Add for V3<T> {
+    type Output = V3<T>;
+    #[inline(always)]
+    fn add(self, o: V3<T>) -> V3<T> {
+        V3::new(self.x + o.x, self.y + o.y, self.z + o.z)
+    }
+}
+
+impl<T: Real> Sub for V3<T> {
+    type Output = V3<T>;
+    #[inline(always)]
+    fn sub(self, o: V3<T>) -> V3<T> {
+        V3::new(self.x - o.x, self.y - o.y, self.z - o.z)
+    }
+}
+
+impl<T: Real> Neg for V3<T> {
+    type Output = V3<T>;
+    #[inline(always)]
+    fn neg(self) -> V3<T> {
+        V3::new(-self.x, -self.y, -self.z)
+    }
+}
+
+/// Component by component (colours).
+impl<T: Real> Mul for V3<T> {
+    type Output = V3<T>;
+    #[inline(always)]
+    fn mul(self, o: V3<T>) -> V3<T> {
+        V3::new(self.x * o.x, self.y * o.y, self.z * o.z)
+    }
+}
+
+impl<T: Real> V3<T> {
+    /// Each component times the lane's number (`Mul<T::Lanes>` would clash with
+    /// the component-wise product for the compiler, so it has a name).
+    #[inline(always)]
+    pub fn scale(self, s: T::Lanes) -> V3<T> {
+        V3::new(self.x * s, self.y * s, self.z * s)
+    }
+}
+
+/// `x` to the whole power `n[i]` in lane `i`, by the repeated squaring of Rust's
+/// `powi` (compiler-builtins' `__powidf2`: multiply the result by `x^(2^k)` for
+/// each set bit `k` of `n`, lowest first), so that each lane rounds as `powi` does.
+#[inline(always)]
+pub fn powi<T: Real>(x: T::Lanes, n: [u32; WIDTH]) -> T::Lanes {
+    let one = T::Lanes::splat(T::of(1.0));
+    if n.iter().all(|&k| k == n[0]) {
+        // One exponent for every lane (all four hit the same object): no masks.
+        let (mut result, mut square, mut k) = (one, x, n[0]);
+        loop {
+            if k & 1 == 1 {
+                result = result * square;
+            }
+            k >>= 1;
+            if k == 0 {
+                return result;
+            }
+            square = square * square;
+        }
+    }
+    let mut result = one;
+    let mut square = x;
+    let mut n = n;
+    loop {
+        let odd = n.iter().enumerate().fold(0, |m, (i, &k)| m | (k & 1) << i);
+        if odd != 0 {
+            result = T::Lanes::mask(odd).select(result * square, result);
+        }
+        n = n.map(|k| k >> 1);
+        if n == [0; WIDTH] {
+            return result;
+        }
+        square = square * square;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Vec3;
+
+    #[test]
+    fn masks_and_bits_agree() {
+        for bits in 0..=ALL {
+            assert_eq!(<wide::f64x4 as Lanes<f64>>::mask(bits).bits(), bits);
+            assert_eq!(<wide::f32x4 as Lanes<f32>>::mask(bits).bits(), bits);
+        }
+        let a = wide::f64x4::new([1.0, 2.0, f64::NAN, 4.0]);
+        let b = wide::f64x4::splat(2.0);
+        assert_eq!(Lanes::<f64>::gt(a, b).bits(), 0b1000);
+        assert_eq!(Lanes::<f64>::ne(a, b).bits(), 0b1101);
+    }
+
+    #[test]
+    fn min_and_max_treat_a_nan_as_rusts_do() {
+        let a = wide::f64x4::new([f64::NAN, 1.0, 3.0, f64::NAN]);
+        let b = wide::f64x4::new([2.0, f64::NAN, 1.0, f64::NAN]);
+        let (lo, hi) = (
+            Lanes::<f64>::min(a, b).to_array(),
+            Lanes::<f64>::max(a, b).to_array(),
+        );
+        let (a, b) = (a.to_array(), b.to_array());
+        for i in 0..3 {
+            assert_eq!(lo[i], a[i].min(b[i]), "lane {i}");
+            assert_eq!(hi[i], a[i].max(b[i]), "lane {i}");
+        }
+        assert!(lo[3].is_nan() && hi[3].is_nan());
+    }
+
+    #[test]
+    fn vector_formulas_round_as_glams_do() {
+        // Awkward numbers, so that another order of operations would round
+        // differently somewhere among them.
+        let vs: [Vec3; 4] = [
+            Vec3::new(0.1, -0.7, 1e-3),
+            Vec3::new(1e8, 3.3, -2.2e-9),
+            Vec3::new(-0.333, 0.333, 0.334),
+            Vec3::new(7.0, 1e-300, -1e300),
+        ];
+        let lanes: V3<f64> = V3::from_vectors(vs);
+        let other = V3::from_vectors([vs[3], vs[0], vs[1], vs[2]]);
+        let (n, d, m) = (
+            lanes.normalize().to_vectors(),
+            lanes.dot(other).to_array(),
+            lanes.max_abs().to_array(),
+        );
+        for i in 0..4 {
+            let o = [vs[3], vs[0], vs[1], vs[2]][i];
+            assert_eq!(n[i], vs[i].normalize(), "normalize, lane {i}");
+            assert_eq!(d[i].to_bits(), vs[i].dot(o).to_bits(), "dot, lane {i}");
+            assert_eq!(m[i], vs[i].abs().max_element(), "max_abs, lane {i}");
+        }
+    }
+
+    #[test]
+    fn powi_rounds_as_rusts_powi_does() {
+        let xs = [0.999_123_456_789, 0.5, 0.87, 1.000_000_1];
+        for n in 0..=256u32 {
+            // Four exponents, and one exponent in every lane.
+            for ns in [[n, (n * 7) % 257, 25, 256 - n], [n; 4]] {
+                let got = powi::<f64>(wide::f64x4::new(xs), ns).to_array();
+                let got32 = powi::<f32>(wide::f32x4::new(xs.map(|x| x as f32)), ns).to_array();
+                for i in 0..4 {
+                    let x = std::hint::black_box(xs[i]);
+                    let k = std::hint::black_box(ns[i] as i32);
+                    assert_eq!(got[i].to_bits(), x.powi(k).to_bits(), "{x}^{k}");
+                    let x32 = x as f32;
+                    assert_eq!(got32[i].to_bits(), x32.powi(k).to_bits(), "{x}^{k} f32");
+                }
+            }
+        }
+    }
+}

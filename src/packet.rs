@@ -1,0 +1,843 @@
+//! Four rays at once: [`Tracer::trace`] for four neighbouring pixels, side by
+//! side in the lanes of SIMD registers.
+//!
+//! The book's tracer follows one ray at a time. Each step of it waits for the one
+//! before: the direction needs a square root and a division, the hit point needs
+//! the distance, which needs another square root, the normal needs the point, and
+//! so on, so the processor spends most of a pixel waiting for results it cannot
+//! yet use. Four neighbouring pixels ask the same questions of the same objects,
+//! so this module asks them together: one instruction works on four rays, and the
+//! four chains of waiting overlap.
+//!
+//! Nothing else changes. The same formulas are computed in the same order, lane
+//! by lane (see [`crate::lanes`]), so every lane gives bit for bit the record the
+//! scalar tracer gives for its pixel: `tests/speed.rs` compares the two on every
+//! scene of the repository, and `tests/fuzz.rs` on random ones.
+//!
+//! Where the four rays part ways (one misses, one is in shadow, one hits another
+//! sphere), each lane has a bit in a mask: lanes whose path has ended are carried
+//! along but change nothing, and the packet stops when no lane is left. Each
+//! object's numbers are kept in every lane ([`Packed`]), so when all four rays hit
+//! the same object, as they mostly do, they are read as they are; otherwise they
+//! are put together lane by lane.
+//!
+//! Two tests that change no result skip most of the work of a miss: a ray heading
+//! away from a sphere's centre cannot meet it in front of its origin, and a ray
+//! whose discriminant is not positive passes beside; when all four rays of a
+//! packet are in one of those cases, the square root and the division are not
+//! computed.
+//!
+//! `--packets on` (the default) traces scenes of up to [`MAX_OBJECTS`] objects by
+//! the plain loop (with the tile masks), and larger ones through the BVH, which a
+//! packet walks together ([`Bvh::search_packet`](crate::bvh::Bvh::search_packet)).
+//! A larger scene without a BVH (`--accel off`, or `--intersect naive`) is traced
+//! one ray at a time.
+
+use crate::accel::{EVERY, TILE};
+use crate::aov::{FirstHit, PixelRecord};
+use crate::bvh::PacketSearch;
+use crate::lanes::{powi, Lanes, ALL, V3, WIDTH};
+use crate::real::{Real, Vector};
+use crate::render::{direction_colour, stratified, Rays, Tracer, HALF_STEP};
+use crate::scene::{Light, Object, Shape};
+use crate::shade::blinn_phong::Viewer;
+use crate::shade::shadow::{Offset, AUTO_FACTOR};
+use crate::sphere::Method;
+use crate::Vec3;
+
+// A packet's pixels must share a tile, so that they share its mask.
+const _: () = assert!(TILE.0 as usize % WIDTH == 0);
+
+/// The most objects the packet tracer takes (one bit each in a search mask).
+pub const MAX_OBJECTS: usize = 64;
+
+/// An object as the packet tracer reads it: every number it needs, in precision
+/// `T` and in every lane, worked out once per render as the scalar tracer works
+/// it out at each hit. Lane `i` of a blend ([`Packed::blend`]) holds the numbers
+/// of the object hit in lane `i`.
+#[derive(Clone, Copy, Debug)]
+pub struct Packed<T: Real> {
+    /// The geometry.
+    shape: Shape4<T>,
+    /// The sphere's radius (zero for a plane).
+    radius: T::Lanes,
+    /// [`Object::magnitude`], for the `auto` offset.
+    magnitude: T::Lanes,
+    /// `ka·la`.
+    ambient: V3<T>,
+    /// `kd·ld`.
+    diffuse_light: V3<T>,
+    /// `ks·ls`.
+    specular_light: V3<T>,
+    /// `kd`, the flat colour before Blinn-Phong.
+    diffuse: V3<T>,
+    /// The exponent of `N·H`, `shininess / 4`.
+    exponent: T::Lanes,
+    /// The exponent as a whole number, where [`blinn_phong::power`] takes `powi`.
+    ///
+    /// [`blinn_phong::power`]: crate::shade::blinn_phong::power
+    whole: [u32; WIDTH],
+    /// The lanes whose exponent is not whole (and take `powf`).
+    fractional: u32,
+    /// The mirror weight.
+    reflection: T::Lanes,
+}
+
+/// An object's geometry in every lane: what the intersection test reads.
+#[derive(Clone, Copy, Debug)]
+pub struct Shape4<T: Real> {
+    /// The lanes whose object is a sphere (the others are true planes).
+    spheres: u32,
+    /// The sphere's centre, or the plane's point.
+    point: V3<T>,
+    /// The plane's unit normal (zero for a sphere).
+    normal: V3<T>,
+    /// `r·r` (zero for a plane).
+    radius_squared: T::Lanes,
+}
+
+impl<T: Real> Shape4<T> {
+    /// A sphere of centre `ball[0..3]` and radius `ball[3]`, given in float64
+    /// (where every number of precision `T` is exact) as the BVH keeps it.
+    #[inline(always)]
+    pub fn ball(ball: &[f64; 4]) -> Shape4<T> {
+        let r = T::of(ball[3]);
+        Shape4 {
+            spheres: ALL,
+            point: V3::splat(T::Vec3::of(crate::Vec3::new(ball[0], ball[1], ball[2]))),
+            normal: V3::splat(T::Vec3::ZERO),
+            radius_squared: T::Lanes::splat(r * r),
+        }
+    }
+
+    /// The geometry of `object`.
+    #[inline(always)]
+    pub fn new(object: &Object<T>) -> Shape4<T> {
+        let (spheres, point, normal, r2) = match object.shape {
+            Shape::Sphere(s) => (ALL, s.center, T::Vec3::ZERO, s.radius * s.radius),
+            Shape::Plane(p) => (0, p.point, p.normal, T::of(0.0)),
+        };
+        Shape4 {
+            spheres,
+            point: V3::splat(point),
+            normal: V3::splat(normal),
+            radius_squared: T::Lanes::splat(r2),
+        }
+    }
+}
+
+impl<T: Real> Packed<T> {
+    /// The numbers of `object` lit by `light`.
+    pub fn new(object: &Object<T>, light: &Light<T>) -> Packed<T> {
+        let m = &object.material;
+        let radius = match object.shape {
+            Shape::Sphere(s) => s.radius,
+            Shape::Plane(_) => T::of(0.0),
+        };
+        let exponent = m.shininess / T::of(4.0);
+        let e = exponent.to_f64();
+        let whole = e.fract() == 0.0 && (0.0..=256.0).contains(&e);
+        let lanes = T::Lanes::splat;
+        Packed {
+            shape: Shape4::new(object),
+            radius: lanes(radius),
+            magnitude: lanes(object.magnitude()),
+            ambient: V3::splat(m.ambient * light.ambient),
+            diffuse_light: V3::splat(m.diffuse * light.diffuse),
+            specular_light: V3::splat(m.specular * light.specular),
+            diffuse: V3::splat(m.diffuse),
+            exponent: lanes(exponent),
+            whole: [if whole { e as u32 } else { 0 }; WIDTH],
+            fractional: if whole { 0 } else { ALL },
+            reflection: lanes(m.reflection),
+        }
+    }
+
+    /// Lane `i` from `of[i]`, for every number.
+    fn blend(of: [&Packed<T>; WIDTH]) -> Packed<T> {
+        let n = |f: &dyn Fn(&Packed<T>) -> T::Lanes| {
+            T::Lanes::from_array(std::array::from_fn(|i| f(of[i]).to_array()[i]))
+        };
+        let v = |f: &dyn Fn(&Packed<T>) -> V3<T>| {
+            V3::new(n(&|o| f(o).x), n(&|o| f(o).y), n(&|o| f(o).z))
+        };
+        let bits = |f: &dyn Fn(&Packed<T>) -> u32| (0..WIDTH).fold(0, |m, i| m | f(of[i]) & 1 << i);
+        Packed {
+            shape: Shape4 {
+                spheres: bits(&|o| o.shape.spheres),
+                point: v(&|o| o.shape.point),
+                normal: v(&|o| o.shape.normal),
+                radius_squared: n(&|o| o.shape.radius_squared),
+            },
+            radius: n(&|o| o.radius),
+            magnitude: n(&|o| o.magnitude),
+            ambient: v(&|o| o.ambient),
+            diffuse_light: v(&|o| o.diffuse_light),
+            specular_light: v(&|o| o.specular_light),
+            diffuse: v(&|o| o.diffuse),
+            exponent: n(&|o| o.exponent),
+            whole: std::array::from_fn(|i| of[i].whole[i]),
+            fractional: bits(&|o| o.fractional),
+            reflection: n(&|o| o.reflection),
+        }
+    }
+}
+
+/// Four rays: lane `i` of `origin` and `direction` is ray `i`.
+#[derive(Clone, Copy, Debug)]
+pub struct Packet<T: Real> {
+    /// Where the rays start.
+    pub origin: V3<T>,
+    /// Their unit directions.
+    pub direction: V3<T>,
+}
+
+impl<T: Real> Packet<T> {
+    /// The points at distances `t`: `O + d·t`.
+    #[inline(always)]
+    fn at(&self, t: T::Lanes) -> V3<T> {
+        self.origin + self.direction.scale(t)
+    }
+}
+
+/// What [`Tracer::trace_packet`] brings back, lane by lane: the colour, the first
+/// hit (where `hit` has the lane's bit) and the rays traced.
+struct Traced4<T: Real> {
+    /// The sum of the path's light, not yet clipped.
+    colour: V3<T>,
+    /// The lanes whose primary ray hit something.
+    hit: u32,
+    /// Of those, the lanes lit at the first hit.
+    lit: u32,
+    /// The lanes whose first hit got Blinn-Phong.
+    shaded: u32,
+    depth: T::Lanes,
+    normal: V3<T>,
+    object: [usize; WIDTH],
+    l_dot_n: T::Lanes,
+    highlight: T::Lanes,
+    shadow_rays: [u32; WIDTH],
+    reflection_rays: [u32; WIDTH],
+}
+
+impl<T: Real> Traced4<T> {
+    /// Black, no hit, no rays.
+    fn blank() -> Traced4<T> {
+        let zero = T::Lanes::splat(T::of(0.0));
+        Traced4 {
+            colour: V3::new(zero, zero, zero),
+            hit: 0,
+            lit: 0,
+            shaded: 0,
+            depth: zero,
+            normal: V3::new(zero, zero, zero),
+            object: [0; WIDTH],
+            l_dot_n: zero,
+            highlight: zero,
+            shadow_rays: [0; WIDTH],
+            reflection_rays: [0; WIDTH],
+        }
+    }
+
+    /// Each lane's colour, clipped to [0, 1].
+    fn colours(&self) -> [Vec3; WIDTH] {
+        self.colour.to_vectors().map(|c| c.clamp01().to_f64())
+    }
+
+    /// Each lane's first hit, as [`Tracer::trace`] records it.
+    fn firsts(&self) -> [Option<FirstHit>; WIDTH] {
+        let (depth, normal) = (self.depth.to_array(), self.normal.to_vectors());
+        let (l_dot_n, highlight) = (self.l_dot_n.to_array(), self.highlight.to_array());
+        std::array::from_fn(|i| {
+            let on = |bits: u32| bits >> i & 1 == 1;
+            let shaded = |x: T| if on(self.shaded) { x.to_f64() } else { 0.0 };
+            on(self.hit).then(|| FirstHit {
+                depth: depth[i].to_f64(),
+                normal: normal[i].to_f64(),
+                lit: on(self.lit),
+                object: self.object[i],
+                diffuse: shaded(l_dot_n[i]),
+                specular: shaded(highlight[i]),
+            })
+        })
+    }
+
+    /// Each lane's rays.
+    fn rays(&self) -> [Rays; WIDTH] {
+        std::array::from_fn(|i| Rays {
+            primary: 1,
+            shadow: u64::from(self.shadow_rays[i]),
+            reflection: u64::from(self.reflection_rays[i]),
+        })
+    }
+}
+
+/// The nearest hit of each lane so far, kept as [`scene::consider`] keeps it:
+/// an object replaces the one found only when it is nearer, or as near with a
+/// lower index, so that the result does not depend on the order of the tests.
+///
+/// [`scene::consider`]: crate::scene::consider
+struct Nearest<'a, T: Real> {
+    tracer: &'a Tracer<T>,
+    ray: &'a Packet<T>,
+    alive: u32,
+    t: T::Lanes,
+    which: [usize; WIDTH],
+    found: T::Lanes,
+}
+
+impl<T: Real> PacketSearch for Nearest<'_, T> {
+    fn limits(&self) -> (u32, <f64 as Real>::Lanes) {
+        let t = self.t.to_array().map(|t| t.to_f64());
+        let limit = <f64 as Real>::Lanes::from_array(t);
+        let none = <f64 as Real>::Lanes::splat(f64::INFINITY);
+        let found = <f64 as Real>::Lanes::mask(self.found.bits());
+        (self.alive, found.select(limit, none))
+    }
+
+    #[inline(always)]
+    fn test(&mut self, index: usize) {
+        self.consider(index, &self.tracer.shape(index));
+    }
+
+    #[inline(always)]
+    fn test_sphere(&mut self, index: usize, ball: &[f64; 4]) {
+        self.consider(index, &Shape4::ball(ball));
+    }
+}
+
+impl<T: Real> Nearest<'_, T> {
+    /// Test object `index`, of geometry `shape`, and keep it where it is nearer.
+    #[inline(always)]
+    fn consider(&mut self, index: usize, shape: &Shape4<T>) {
+        let (t, hit) = self.tracer.hits(shape, self.ray);
+        if hit.bits() == 0 {
+            return;
+        }
+        let mut nearer = (hit & (!self.found | t.lt(self.t))).bits();
+        let tie = (hit & self.found & !t.ne(self.t)).bits();
+        for i in lanes_of(tie) {
+            if index < self.which[i] {
+                nearer |= 1 << i;
+            }
+        }
+        let m = T::Lanes::mask(nearer);
+        self.t = m.select(t, self.t);
+        for i in lanes_of(nearer) {
+            self.which[i] = index;
+        }
+        self.found = self.found | m;
+    }
+}
+
+/// The lanes whose shadow ray is blocked so far.
+struct Blocked<'a, T: Real> {
+    tracer: &'a Tracer<T>,
+    ray: &'a Packet<T>,
+    distance: T::Lanes,
+    alive: u32,
+    blocked: u32,
+}
+
+impl<T: Real> PacketSearch for Blocked<'_, T> {
+    fn limits(&self) -> (u32, <f64 as Real>::Lanes) {
+        let d = self.distance.to_array().map(|d| d.to_f64());
+        (
+            self.alive & !self.blocked,
+            <f64 as Real>::Lanes::from_array(d),
+        )
+    }
+
+    #[inline(always)]
+    fn test(&mut self, index: usize) {
+        let (t, hit) = self.tracer.hits(&self.tracer.shape(index), self.ray);
+        self.blocked |= (hit & t.lt(self.distance)).bits();
+    }
+
+    #[inline(always)]
+    fn test_sphere(&mut self, _index: usize, ball: &[f64; 4]) {
+        let (t, hit) = self.tracer.hits(&Shape4::ball(ball), self.ray);
+        self.blocked |= (hit & t.lt(self.distance)).bits();
+    }
+}
+
+/// The rays' origins and the reciprocals of their directions in float64, as the
+/// BVH's box test takes them.
+#[inline(always)]
+fn in_float64<T: Real>(ray: &Packet<T>) -> (V3<f64>, V3<f64>) {
+    let wide = |l: T::Lanes| <f64 as Real>::Lanes::from_array(l.to_array().map(|x| x.to_f64()));
+    let v = |v: &V3<T>| V3::<f64>::new(wide(v.x), wide(v.y), wide(v.z));
+    let one = <f64 as Real>::Lanes::splat(1.0);
+    let d = v(&ray.direction);
+    (v(&ray.origin), V3::new(one / d.x, one / d.y, one / d.z))
+}
+
+/// The lanes `bits` as indices.
+#[inline(always)]
+fn lanes_of(bits: u32) -> impl Iterator<Item = usize> {
+    (0..WIDTH).filter(move |i| bits >> i & 1 == 1)
+}
+
+/// Add one to `counts[i]` for each lane `i` of `bits`.
+#[inline(always)]
+fn count(counts: &mut [u32; WIDTH], bits: u32) {
+    for (i, c) in counts.iter_mut().enumerate() {
+        *c += bits >> i & 1;
+    }
+}
+
+/// The objects of a search mask, lowest index first.
+#[inline(always)]
+fn each_object(mut bits: u64, mut f: impl FnMut(usize) -> bool) {
+    while bits != 0 {
+        let index = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        if !f(index) {
+            return;
+        }
+    }
+}
+
+impl<T: Real> Tracer<T> {
+    // ANCHOR: packet
+    /// The records of pixels `col`, `col + 1`, … of row `row`, one per element of
+    /// `out` (at most [`WIDTH`]), traced as one packet: what [`Tracer::pixel`] gives
+    /// for each of them, and the rays they took.
+    pub fn pixel_packet(&self, row: u32, col: u32, out: &mut [PixelRecord]) -> Rays {
+        let n = out.len();
+        assert!((1..=WIDTH).contains(&n), "a packet has 1 to {WIDTH} pixels");
+        let lanes = ALL >> (WIDTH - n);
+        // Lanes past the image's right edge repeat its last pixel, and are dropped.
+        let cols: [f64; WIDTH] = std::array::from_fn(|i| f64::from(col + i.min(n - 1) as u32));
+        let ray = self.rays_through([f64::from(row); WIDTH], cols);
+        let mut total = Rays::default();
+        if !self.stages.intersection {
+            for (pixel, d) in out.iter_mut().zip(ray.direction.to_vectors()) {
+                let colour = direction_colour(d.to_f64()).clamp(Vec3::ZERO, Vec3::ONE);
+                *pixel = PixelRecord::new(colour, None, 0, 1);
+                total.primary += 1;
+            }
+            return total;
+        }
+        let candidates = self.masks.mask(row, col);
+        let mut centre = Traced4::blank();
+        self.trace_packet(ray, lanes, candidates, &mut centre);
+        let mut colour = centre.colours();
+        let mut rays = centre.rays();
+        if self.spp > 1 {
+            // Several samples: the mean colour; the buffers keep the centre ray's.
+            let mut sum = [Vec3::ZERO; WIDTH];
+            let mut traced = Traced4::blank();
+            for sample in 0..self.spp {
+                let at: [(f64, f64); WIDTH] =
+                    std::array::from_fn(|i| stratified(row, cols[i] as u32, sample, self.spp));
+                let ray = self.rays_through(at.map(|a| a.0), at.map(|a| a.1));
+                self.trace_packet(ray, lanes, candidates, &mut traced);
+                for (i, (c, r)) in traced.colours().into_iter().zip(traced.rays()).enumerate() {
+                    sum[i] += c;
+                    rays[i] += r;
+                }
+            }
+            colour = sum.map(|s| s / f64::from(self.spp));
+        }
+        let first = centre.firsts();
+        for (i, pixel) in out.iter_mut().enumerate() {
+            let bounces = u64::from(centre.reflection_rays[i]);
+            *pixel = PixelRecord::new(colour[i], first[i], bounces, rays[i].total());
+            total += rays[i];
+        }
+        total
+    }
+    // ANCHOR_END: packet
+
+    /// The rays from the eye through the screen at fractional (`rows[i]`,
+    /// `cols[i]`), as [`Camera::ray_through`](crate::camera::Camera::ray_through)
+    /// computes each.
+    #[inline(always)]
+    fn rays_through(&self, rows: [f64; WIDTH], cols: [f64; WIDTH]) -> Packet<T> {
+        let camera = &self.camera;
+        let s = &camera.screen;
+        // `from + i·(to − from)/(n − 1)`, as the camera's grid.
+        let grid = |from: f64, to: f64, at: [f64; WIDTH], n: u32| {
+            let (from, to) = (T::of(from), T::of(to));
+            if n < 2 {
+                return T::Lanes::splat(from);
+            }
+            T::Lanes::splat(from)
+                + T::Lanes::from_array(at.map(T::of)) * T::Lanes::splat(to - from)
+                    / T::Lanes::splat(T::of(f64::from(n - 1)))
+        };
+        let x = grid(s.left, s.right, cols, camera.width);
+        let y = grid(s.top, s.bottom, rows, camera.height);
+        let origin = V3::splat(T::Vec3::of(camera.position));
+        let target = V3::new(x, y, T::Lanes::splat(T::of(0.0)));
+        Packet {
+            origin,
+            direction: (target - origin).normalize(),
+        }
+    }
+
+    // ANCHOR: trace_packet
+    /// [`Tracer::trace`] for the four rays of `primary`, of which the lanes `lanes`
+    /// count.
+    fn trace_packet(
+        &self,
+        mut ray: Packet<T>,
+        lanes: u32,
+        candidates: u64,
+        traced: &mut Traced4<T>,
+    ) {
+        let segments = if self.stages.reflection {
+            self.max_depth
+        } else {
+            1
+        };
+        *traced = Traced4::blank();
+        let mut weight = T::Lanes::splat(T::of(1.0));
+        let light = V3::<T>::splat(self.light.position);
+        let mut alive = lanes; // the lanes whose path goes on
+        for segment in 0..segments {
+            if segment > 0 {
+                count(&mut traced.reflection_rays, alive);
+            }
+            // The nearest object along each ray; the lanes that find none end.
+            let search = if segment == 0 { candidates } else { EVERY };
+            let (t, which, found) = self.nearest_packet(&ray, alive, search);
+            alive &= found;
+            if alive == 0 {
+                break;
+            }
+            let made;
+            let object = match (self.same_object(&which, alive), self.bvh.is_some()) {
+                (Some(index), false) => &self.packed[index],
+                // The many objects of a BVH are not kept in lanes: made for the hit.
+                (Some(index), true) => {
+                    made = Packed::new(&self.objects[index], &self.light);
+                    &made
+                }
+                (None, false) => {
+                    made = Packed::blend(which.map(|w| &self.packed[w]));
+                    &made
+                }
+                (None, true) => {
+                    let each = which.map(|w| Packed::new(&self.objects[w], &self.light));
+                    made = Packed::blend(std::array::from_fn(|i| &each[i]));
+                    &made
+                }
+            };
+            let point = ray.at(t);
+            let normal = self.normal_packet(object, alive, point, &ray);
+            let shifted = self.step_off_packet(object, alive, point, normal);
+            let to_light = (light - shifted).normalize();
+
+            // Shadow: the lanes whose point does not see the light end, black.
+            let lit = if self.stages.shadow {
+                count(&mut traced.shadow_rays, alive);
+                let light_distance = (light - point).length();
+                let shadow_ray = Packet {
+                    origin: shifted,
+                    direction: to_light,
+                };
+                alive & !self.blocked_packet(&shadow_ray, light_distance, alive)
+            } else {
+                alive
+            };
+
+            // Blinn-Phong, seen from the camera (or the ray's origin), where lit.
+            let shading = lit != 0 && self.stages.blinn_phong;
+            let terms = shading.then(|| {
+                let viewer = match self.viewer {
+                    Viewer::Camera => V3::splat(T::Vec3::of(self.camera.position)),
+                    Viewer::RayOrigin => ray.origin,
+                };
+                let to_viewer = (viewer - point).normalize();
+                self.terms_packet(object, lit, normal, to_light, to_viewer)
+            });
+            if segment == 0 {
+                traced.hit = alive;
+                traced.lit = lit;
+                traced.depth = t;
+                traced.normal = normal;
+                traced.object = which;
+                if let Some(terms) = &terms {
+                    traced.shaded = lit;
+                    (traced.l_dot_n, traced.highlight) = (terms.l_dot_n, terms.highlight);
+                }
+            }
+            alive = lit;
+            if alive == 0 {
+                break;
+            }
+            // Without Blinn-Phong, the object's flat diffuse colour.
+            let illumination = match terms {
+                Some(terms) => terms.sum,
+                None => object.diffuse,
+            };
+            // Reflection: add this segment's light, weighted, and bounce.
+            let on = T::Lanes::mask(alive);
+            traced.colour = V3::select(
+                on,
+                traced.colour + illumination.scale(weight),
+                traced.colour,
+            );
+            weight = on.select(weight * object.reflection, weight);
+            let d = ray.direction;
+            ray = Packet {
+                origin: shifted,
+                direction: d - normal.scale(T::Lanes::splat(T::of(2.0)) * d.dot(normal)),
+            };
+            // Early stop: nothing the rest of the path adds can change the pixel.
+            let left = (segments - segment - 1) as usize;
+            if let Some(&reach) = self.reach.get(left) {
+                let w = weight.to_array();
+                for (i, w) in w.iter().enumerate() {
+                    if w.to_f64() * reach < HALF_STEP {
+                        alive &= !(1 << i);
+                    }
+                }
+                if alive == 0 {
+                    break;
+                }
+            }
+        }
+    }
+    // ANCHOR_END: trace_packet
+
+    /// The object every lane of `alive` hit, if it is one; lanes outside `alive`
+    /// are set to it, so that a blend never reads a stale index.
+    #[inline(always)]
+    fn same_object(&self, which: &[usize; WIDTH], alive: u32) -> Option<usize> {
+        let some = which[alive.trailing_zeros() as usize];
+        let same = (0..WIDTH).all(|i| alive >> i & 1 == 0 || which[i] == some);
+        same.then_some(some)
+    }
+
+    // ANCHOR: nearest_packet
+    /// The nearest object along each ray of the lanes `alive`: its distance and
+    /// index, lane by lane, and the lanes that found one. Through the BVH if there
+    /// is one, else the plain loop over the objects `search` selects.
+    #[inline(always)]
+    fn nearest_packet(
+        &self,
+        ray: &Packet<T>,
+        alive: u32,
+        search: u64,
+    ) -> (T::Lanes, [usize; WIDTH], u32) {
+        let mut nearest = Nearest {
+            tracer: self,
+            ray,
+            alive,
+            t: T::Lanes::splat(T::of(0.0)),
+            which: [0; WIDTH],
+            found: T::Lanes::mask(0),
+        };
+        match &self.bvh {
+            Some(bvh) => {
+                let (origin, inverse) = in_float64(ray);
+                bvh.search_packet(&origin, &inverse, &mut nearest);
+            }
+            None => each_object(search & self.every_object(), |index| {
+                nearest.test(index);
+                true
+            }),
+        }
+        (nearest.t, nearest.which, nearest.found.bits())
+    }
+
+    /// The lanes among `alive` whose ray meets an object closer than `distance`:
+    /// the shadow test, which stops once every lane is blocked.
+    #[inline(always)]
+    fn blocked_packet(&self, ray: &Packet<T>, distance: T::Lanes, alive: u32) -> u32 {
+        let mut blocked = Blocked {
+            tracer: self,
+            ray,
+            distance,
+            alive,
+            blocked: 0,
+        };
+        match &self.bvh {
+            Some(bvh) => {
+                let (origin, inverse) = in_float64(ray);
+                bvh.search_packet(&origin, &inverse, &mut blocked);
+            }
+            None => each_object(self.every_object(), |index| {
+                blocked.test(index);
+                blocked.blocked & alive != alive
+            }),
+        }
+        blocked.blocked
+    }
+    // ANCHOR_END: nearest_packet
+
+    /// The geometry of object `index`: kept in lanes for a short list, made on the
+    /// spot for the many objects of a BVH.
+    #[inline(always)]
+    fn shape(&self, index: usize) -> Shape4<T> {
+        match self.packed.get(index) {
+            Some(p) => p.shape,
+            None => Shape4::new(&self.objects[index]),
+        }
+    }
+
+    /// The search mask of every object.
+    #[inline(always)]
+    fn every_object(&self) -> u64 {
+        match self.packed.len() {
+            0 => 0,
+            n => EVERY >> (MAX_OBJECTS - n),
+        }
+    }
+    /// Distance along each ray to `object`, and the mask of the lanes that hit it,
+    /// by the rules of [`Object::intersect`].
+    #[inline(always)]
+    fn hits(&self, object: &Shape4<T>, ray: &Packet<T>) -> (T::Lanes, T::Lanes) {
+        let zero = T::Lanes::splat(T::of(0.0));
+        let (d, o) = (ray.direction, ray.origin);
+        if object.spheres == 0 {
+            let n = object.normal;
+            let facing = d.dot(n);
+            let t = (object.point - o).dot(n) / facing;
+            let finite = t.abs().lt(T::Lanes::splat(T::of(f64::INFINITY)));
+            return (t, facing.ne(zero) & t.gt(zero) & finite);
+        }
+        let r2 = object.radius_squared;
+        let f = o - object.point;
+        // ANCHOR: early_out
+        let d_dot_f = d.dot(f);
+        // A ray heading away from the centre (⟨d, f⟩ > 0) meets the sphere, if at
+        // all, behind its origin: a miss by the rule "both crossings in front". Most
+        // shadow and reflected rays leave a sphere so; if all four do, skip the rest.
+        if d_dot_f.gt(zero).bits() == ALL {
+            return (zero, T::Lanes::mask(0));
+        }
+        let (near, far, hit) = match self.method {
+            Method::Stable => {
+                let h = -d_dot_f;
+                let closest = f + d.scale(h);
+                let quarter_delta = r2 - closest.length_squared();
+                let crosses = quarter_delta.gt(zero);
+                if crosses.bits() == 0 {
+                    return (zero, crosses); // every ray passes beside
+                }
+                // ANCHOR_END: early_out
+                let root = quarter_delta.sqrt();
+                let q = h + h.ge(zero).select(root, -root);
+                let c = f.length_squared() - r2;
+                let t1 = c / q;
+                (t1.min(q), t1.max(q), crosses & q.ne(zero))
+            }
+            Method::Naive => {
+                let two = T::Lanes::splat(T::of(2.0));
+                let b = two * d_dot_f;
+                let c = f.length_squared() - r2;
+                let delta = b * b - T::Lanes::splat(T::of(4.0)) * c;
+                let crosses = delta.gt(zero);
+                if crosses.bits() == 0 {
+                    return (zero, crosses);
+                }
+                let root = delta.sqrt();
+                let (t1, t2) = ((-b + root) / two, (-b - root) / two);
+                (t1.min(t2), t1.max(t2), crosses)
+            }
+        };
+        (near, hit & near.gt(zero) & far.gt(zero))
+    }
+
+    /// The unit normal at each hit point, as [`Object::normal_at`] gives it.
+    #[inline(always)]
+    fn normal_packet(
+        &self,
+        object: &Packed<T>,
+        alive: u32,
+        point: V3<T>,
+        ray: &Packet<T>,
+    ) -> V3<T> {
+        let shape = &object.shape;
+        let spheres = shape.spheres & alive;
+        let sphere = || (point - shape.point).normalize();
+        if spheres == alive {
+            return sphere();
+        }
+        let n = shape.normal;
+        let plane = V3::select(ray.direction.dot(n).gt(T::Lanes::splat(T::of(0.0))), -n, n);
+        if spheres == 0 {
+            return plane;
+        }
+        V3::select(T::Lanes::mask(spheres), sphere(), plane)
+    }
+
+    /// [`step_off`](crate::shade::shadow::step_off) for each lane.
+    #[inline(always)]
+    fn step_off_packet(
+        &self,
+        object: &Packed<T>,
+        alive: u32,
+        point: V3<T>,
+        normal: V3<T>,
+    ) -> V3<T> {
+        match self.offset {
+            Offset::Fixed(step) => point + normal.scale(T::Lanes::splat(T::of(step))),
+            Offset::Auto => {
+                let shape = &object.shape;
+                let spheres = shape.spheres & alive;
+                let on_sphere = || shape.point + normal.scale(object.radius);
+                let on_surface = if spheres == alive {
+                    on_sphere()
+                } else {
+                    let n = shape.normal;
+                    let on_plane = point - n.scale((point - shape.point).dot(n));
+                    if spheres == 0 {
+                        on_plane
+                    } else {
+                        V3::select(T::Lanes::mask(spheres), on_sphere(), on_plane)
+                    }
+                };
+                let scale = object.magnitude.max(on_surface.max_abs());
+                let bound = T::Lanes::splat(T::of(AUTO_FACTOR) * T::UNIT_ROUNDOFF) * scale;
+                on_surface + normal.scale(bound)
+            }
+        }
+    }
+
+    /// [`blinn_phong::terms`](crate::shade::blinn_phong::terms) for each lane.
+    #[inline(always)]
+    fn terms_packet(
+        &self,
+        object: &Packed<T>,
+        lit: u32,
+        normal: V3<T>,
+        to_light: V3<T>,
+        to_viewer: V3<T>,
+    ) -> Terms4<T> {
+        let l_dot_n = to_light.dot(normal);
+        let half = (to_light + to_viewer).normalize();
+        let n_dot_h = normal.dot(half).max(T::Lanes::splat(T::of(0.0)));
+        // blinn_phong::power: repeated squaring for a whole exponent, powf otherwise.
+        let mut highlight = powi::<T>(n_dot_h, object.whole);
+        if object.fractional & lit != 0 {
+            let (x, e, mut h) = (
+                n_dot_h.to_array(),
+                object.exponent.to_array(),
+                highlight.to_array(),
+            );
+            for i in (0..WIDTH).filter(|i| (object.fractional & lit) >> i & 1 == 1) {
+                h[i] = x[i].powf(e[i]);
+            }
+            highlight = T::Lanes::from_array(h);
+        }
+        let diffuse = object.diffuse_light.scale(l_dot_n);
+        let specular = object.specular_light.scale(highlight);
+        Terms4 {
+            sum: object.ambient + diffuse + specular,
+            l_dot_n,
+            highlight,
+        }
+    }
+}
+
+/// Blinn-Phong's terms in each lane: their sum, and the factors the buffers keep.
+struct Terms4<T: Real> {
+    sum: V3<T>,
+    l_dot_n: T::Lanes,
+    highlight: T::Lanes,
+}
