@@ -244,7 +244,7 @@ pub struct RuleArgs {
     #[arg(long, value_enum)]
     pub accel: Option<Accel>,
     /// Trace four neighbouring pixels at once, in SIMD lanes; never changes a
-    /// pixel (scenes with a BVH trace one ray at a time) [default: on].
+    /// pixel [default: on].
     #[arg(long, value_enum, value_name = "on|off")]
     pub packets: Option<Switch>,
 }

@@ -406,6 +406,12 @@ impl<T: Real> Tracer<T> {
     pub fn pixel_packet(&self, row: u32, col: u32, out: &mut [PixelRecord]) -> Rays {
         let n = out.len();
         assert!((1..=WIDTH).contains(&n), "a packet has 1 to {WIDTH} pixels");
+        // The four pixels share the tile mask of the first, and the objects in lanes.
+        debug_assert!(
+            col as usize % WIDTH == 0,
+            "a packet starts at a multiple of {WIDTH}"
+        );
+        debug_assert!(self.packets, "a tracer made without packets");
         let lanes = ALL >> (WIDTH - n);
         // Lanes past the image's right edge repeat its last pixel, and are dropped.
         let cols: [f64; WIDTH] = std::array::from_fn(|i| f64::from(col + i.min(n - 1) as u32));
@@ -603,8 +609,8 @@ impl<T: Real> Tracer<T> {
     }
     // ANCHOR_END: trace_packet
 
-    /// The object every lane of `alive` hit, if it is one; lanes outside `alive`
-    /// are set to it, so that a blend never reads a stale index.
+    /// The object every lane of `alive` hit, if it is one. (Lanes outside `alive`
+    /// hold the index of an earlier hit or 0, always a valid object.)
     #[inline(always)]
     fn same_object(&self, which: &[usize; WIDTH], alive: u32) -> Option<usize> {
         let some = which[alive.trailing_zeros() as usize];
