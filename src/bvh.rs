@@ -19,7 +19,7 @@
 //! renders both ways and compares the bytes). Boxes are computed in float64 and
 //! widened by a relative 1e-9, far more than their rounding.
 
-use crate::lanes::{Lanes, V3};
+use crate::lanes::{F64s, Lanes, V3};
 use crate::ray::Ray;
 use crate::real::{Real, Vector};
 use crate::scene::{consider, Hit, Object, Role, Shape};
@@ -312,14 +312,13 @@ impl Bvh {
     }
 }
 
-/// Four numbers of float64, the lanes of a packet's box tests.
-type F64s = <f64 as Real>::Lanes;
-
-/// What a packet's walk through the tree asks of its rays ([`Bvh::search_packet`]).
+/// What a search for objects along a packet's rays asks of them: the tree's walk
+/// ([`Bvh::search_packet`]), or the plain loop.
 pub trait PacketSearch {
-    /// The lanes still searching (none: the walk stops), and for each lane the
-    /// distance beyond which a box need not be entered.
-    fn limits(&self) -> (u32, F64s);
+    /// The lanes still searching (none: the search stops).
+    fn active(&self) -> u32;
+    /// For each lane, the distance beyond which a box need not be entered.
+    fn limits(&self) -> F64s;
     /// Test object `index` against the rays.
     fn test(&mut self, index: usize);
     /// Test object `index`, a sphere of centre `ball[0..3]` and radius `ball[3]`.
@@ -352,11 +351,11 @@ impl Bvh {
     /// as near as its limit; objects it did not need are tested too, and cannot
     /// come nearer. Children are visited nearer first for the lowest lane that
     /// enters both (the first child first if no lane enters both).
-    pub fn search_packet(
+    pub fn search_packet<S: PacketSearch>(
         &self,
         origin: &V3<f64>,
         inverse: &V3<f64>,
-        search: &mut impl PacketSearch,
+        search: &mut S,
     ) {
         for &i in &self.loose {
             search.test(i as usize);
@@ -364,11 +363,12 @@ impl Bvh {
         if self.nodes.is_empty() {
             return;
         }
+        let limits = |search: &S| (search.active(), search.limits());
         let enters = |node: usize, (active, limit): (u32, F64s)| {
             let (near, bits) = Self::enter_packet(&self.nodes[node], origin, inverse, limit);
             (near, bits & active)
         };
-        if enters(0, search.limits()).1 == 0 {
+        if enters(0, limits(search)).1 == 0 {
             return;
         }
         let mut stack = [0u32; 64];
@@ -382,7 +382,7 @@ impl Bvh {
                 }
             } else {
                 let (a, b) = (node + 1, n.first as usize);
-                let limits = search.limits();
+                let limits = limits(search);
                 let (ta, ma) = enters(a, limits);
                 let (tb, mb) = enters(b, limits);
                 if ma != 0 && mb != 0 {
@@ -407,7 +407,7 @@ impl Bvh {
                 }
                 depth -= 1;
                 let candidate = stack[depth] as usize;
-                if enters(candidate, search.limits()).1 != 0 {
+                if enters(candidate, limits(search)).1 != 0 {
                     node = candidate;
                     break;
                 }

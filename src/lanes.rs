@@ -27,6 +27,10 @@ pub const WIDTH: usize = 4;
 /// The bits of every lane.
 pub const ALL: u32 = (1 << WIDTH) - 1;
 
+/// Four numbers of float64 (a packet's box tests are in float64 whatever the
+/// precision, as the one-ray BVH's are).
+pub type F64s = <f64 as Real>::Lanes;
+
 /// Four numbers of precision `T` computed together.
 pub trait Lanes<T: Real>:
     Copy

@@ -36,11 +36,11 @@
 use crate::accel::{EVERY, TILE};
 use crate::aov::{FirstHit, PixelRecord};
 use crate::bvh::PacketSearch;
-use crate::lanes::{powi, Lanes, ALL, V3, WIDTH};
+use crate::lanes::{powi, F64s, Lanes, ALL, V3, WIDTH};
 use crate::real::{Real, Vector};
 use crate::render::{direction_colour, stratified, Rays, Tracer, HALF_STEP};
 use crate::scene::{Light, Object, Shape};
-use crate::shade::blinn_phong::Viewer;
+use crate::shade::blinn_phong::{whole_exponent, Viewer};
 use crate::shade::shadow::{Offset, AUTO_FACTOR};
 use crate::sphere::Method;
 use crate::Vec3;
@@ -73,7 +73,8 @@ pub struct Packed<T: Real> {
     diffuse: V3<T>,
     /// The exponent of `N·H`, `shininess / 4`.
     exponent: T::Lanes,
-    /// The exponent as a whole number, where [`blinn_phong::power`] takes `powi`.
+    /// The exponent as a whole number, where [`blinn_phong::power`] takes `powi`
+    /// ([`whole_exponent`]).
     ///
     /// [`blinn_phong::power`]: crate::shade::blinn_phong::power
     whole: [u32; WIDTH],
@@ -97,31 +98,36 @@ pub struct Shape4<T: Real> {
 }
 
 impl<T: Real> Shape4<T> {
+    /// The sphere of centre `center` and radius `radius`.
+    #[inline(always)]
+    fn sphere(center: T::Vec3, radius: T) -> Shape4<T> {
+        Shape4 {
+            spheres: ALL,
+            point: V3::splat(center),
+            normal: V3::splat(T::Vec3::ZERO),
+            radius_squared: T::Lanes::splat(radius * radius),
+        }
+    }
+
     /// A sphere of centre `ball[0..3]` and radius `ball[3]`, given in float64
     /// (where every number of precision `T` is exact) as the BVH keeps it.
     #[inline(always)]
     pub fn ball(ball: &[f64; 4]) -> Shape4<T> {
-        let r = T::of(ball[3]);
-        Shape4 {
-            spheres: ALL,
-            point: V3::splat(T::Vec3::of(crate::Vec3::new(ball[0], ball[1], ball[2]))),
-            normal: V3::splat(T::Vec3::ZERO),
-            radius_squared: T::Lanes::splat(r * r),
-        }
+        let center = T::Vec3::of(Vec3::new(ball[0], ball[1], ball[2]));
+        Shape4::sphere(center, T::of(ball[3]))
     }
 
     /// The geometry of `object`.
     #[inline(always)]
     pub fn new(object: &Object<T>) -> Shape4<T> {
-        let (spheres, point, normal, r2) = match object.shape {
-            Shape::Sphere(s) => (ALL, s.center, T::Vec3::ZERO, s.radius * s.radius),
-            Shape::Plane(p) => (0, p.point, p.normal, T::of(0.0)),
-        };
-        Shape4 {
-            spheres,
-            point: V3::splat(point),
-            normal: V3::splat(normal),
-            radius_squared: T::Lanes::splat(r2),
+        match object.shape {
+            Shape::Sphere(s) => Shape4::sphere(s.center, s.radius),
+            Shape::Plane(p) => Shape4 {
+                spheres: 0,
+                point: V3::splat(p.point),
+                normal: V3::splat(p.normal),
+                radius_squared: T::Lanes::splat(T::of(0.0)),
+            },
         }
     }
 }
@@ -135,8 +141,7 @@ impl<T: Real> Packed<T> {
             Shape::Plane(_) => T::of(0.0),
         };
         let exponent = m.shininess / T::of(4.0);
-        let e = exponent.to_f64();
-        let whole = e.fract() == 0.0 && (0.0..=256.0).contains(&e);
+        let whole = whole_exponent(exponent);
         let lanes = T::Lanes::splat;
         Packed {
             shape: Shape4::new(object),
@@ -147,8 +152,8 @@ impl<T: Real> Packed<T> {
             specular_light: V3::splat(m.specular * light.specular),
             diffuse: V3::splat(m.diffuse),
             exponent: lanes(exponent),
-            whole: [if whole { e as u32 } else { 0 }; WIDTH],
-            fractional: if whole { 0 } else { ALL },
+            whole: [whole.unwrap_or(0); WIDTH],
+            fractional: if whole.is_some() { 0 } else { ALL },
             reflection: lanes(m.reflection),
         }
     }
@@ -287,17 +292,19 @@ struct Nearest<'a, T: Real> {
 }
 
 impl<T: Real> PacketSearch for Nearest<'_, T> {
-    fn limits(&self) -> (u32, <f64 as Real>::Lanes) {
-        let t = self.t.to_array().map(|t| t.to_f64());
-        let limit = <f64 as Real>::Lanes::from_array(t);
-        let none = <f64 as Real>::Lanes::splat(f64::INFINITY);
-        let found = <f64 as Real>::Lanes::mask(self.found.bits());
-        (self.alive, found.select(limit, none))
+    fn active(&self) -> u32 {
+        self.alive
+    }
+
+    fn limits(&self) -> F64s {
+        let none = F64s::splat(f64::INFINITY);
+        F64s::mask(self.found.bits()).select(in_f64::<T>(self.t), none)
     }
 
     #[inline(always)]
     fn test(&mut self, index: usize) {
-        self.consider(index, &self.tracer.shape(index));
+        let tracer = self.tracer;
+        tracer.with_shape(index, |shape| self.consider(index, shape));
     }
 
     #[inline(always)]
@@ -340,34 +347,48 @@ struct Blocked<'a, T: Real> {
 }
 
 impl<T: Real> PacketSearch for Blocked<'_, T> {
-    fn limits(&self) -> (u32, <f64 as Real>::Lanes) {
-        let d = self.distance.to_array().map(|d| d.to_f64());
-        (
-            self.alive & !self.blocked,
-            <f64 as Real>::Lanes::from_array(d),
-        )
+    /// The lanes not blocked yet: none, and the search stops.
+    fn active(&self) -> u32 {
+        self.alive & !self.blocked
+    }
+
+    fn limits(&self) -> F64s {
+        in_f64::<T>(self.distance)
     }
 
     #[inline(always)]
     fn test(&mut self, index: usize) {
-        let (t, hit) = self.tracer.hits(&self.tracer.shape(index), self.ray);
-        self.blocked |= (hit & t.lt(self.distance)).bits();
+        let tracer = self.tracer;
+        tracer.with_shape(index, |shape| self.consider(shape));
     }
 
     #[inline(always)]
     fn test_sphere(&mut self, _index: usize, ball: &[f64; 4]) {
-        let (t, hit) = self.tracer.hits(&Shape4::ball(ball), self.ray);
+        self.consider(&Shape4::ball(ball));
+    }
+}
+
+impl<T: Real> Blocked<'_, T> {
+    /// Test an object of geometry `shape`: does it stand before the light?
+    #[inline(always)]
+    fn consider(&mut self, shape: &Shape4<T>) {
+        let (t, hit) = self.tracer.hits(shape, self.ray);
         self.blocked |= (hit & t.lt(self.distance)).bits();
     }
+}
+
+/// The lanes `l` in float64 (exactly).
+#[inline(always)]
+fn in_f64<T: Real>(l: T::Lanes) -> F64s {
+    F64s::from_array(l.to_array().map(|x| x.to_f64()))
 }
 
 /// The rays' origins and the reciprocals of their directions in float64, as the
 /// BVH's box test takes them.
 #[inline(always)]
 fn in_float64<T: Real>(ray: &Packet<T>) -> (V3<f64>, V3<f64>) {
-    let wide = |l: T::Lanes| <f64 as Real>::Lanes::from_array(l.to_array().map(|x| x.to_f64()));
-    let v = |v: &V3<T>| V3::<f64>::new(wide(v.x), wide(v.y), wide(v.z));
-    let one = <f64 as Real>::Lanes::splat(1.0);
+    let v = |v: &V3<T>| V3::<f64>::new(in_f64::<T>(v.x), in_f64::<T>(v.y), in_f64::<T>(v.z));
+    let one = F64s::splat(1.0);
     let d = v(&ray.direction);
     (v(&ray.origin), V3::new(one / d.x, one / d.y, one / d.z))
 }
@@ -383,18 +404,6 @@ fn lanes_of(bits: u32) -> impl Iterator<Item = usize> {
 fn count(counts: &mut [u32; WIDTH], bits: u32) {
     for (i, c) in counts.iter_mut().enumerate() {
         *c += bits >> i & 1;
-    }
-}
-
-/// The objects of a search mask, lowest index first.
-#[inline(always)]
-fn each_object(mut bits: u64, mut f: impl FnMut(usize) -> bool) {
-    while bits != 0 {
-        let index = bits.trailing_zeros() as usize;
-        bits &= bits - 1;
-        if !f(index) {
-            return;
-        }
     }
 }
 
@@ -620,8 +629,7 @@ impl<T: Real> Tracer<T> {
 
     // ANCHOR: nearest_packet
     /// The nearest object along each ray of the lanes `alive`: its distance and
-    /// index, lane by lane, and the lanes that found one. Through the BVH if there
-    /// is one, else the plain loop over the objects `search` selects.
+    /// index, lane by lane, and the lanes that found one.
     #[inline(always)]
     fn nearest_packet(
         &self,
@@ -637,16 +645,7 @@ impl<T: Real> Tracer<T> {
             which: [0; WIDTH],
             found: T::Lanes::mask(0),
         };
-        match &self.bvh {
-            Some(bvh) => {
-                let (origin, inverse) = in_float64(ray);
-                bvh.search_packet(&origin, &inverse, &mut nearest);
-            }
-            None => each_object(search & self.every_object(), |index| {
-                nearest.test(index);
-                true
-            }),
-        }
+        self.search_packet(ray, search, &mut nearest);
         (nearest.t, nearest.which, nearest.found.bits())
     }
 
@@ -661,27 +660,35 @@ impl<T: Real> Tracer<T> {
             alive,
             blocked: 0,
         };
-        match &self.bvh {
-            Some(bvh) => {
-                let (origin, inverse) = in_float64(ray);
-                bvh.search_packet(&origin, &inverse, &mut blocked);
-            }
-            None => each_object(self.every_object(), |index| {
-                blocked.test(index);
-                blocked.blocked & alive != alive
-            }),
-        }
+        self.search_packet(ray, EVERY, &mut blocked);
         blocked.blocked
+    }
+
+    /// Put the objects to `search`: through the BVH if there is one, else the
+    /// plain loop over the objects the mask `objects` selects, lowest index first,
+    /// until no lane is still searching.
+    #[inline(always)]
+    fn search_packet(&self, ray: &Packet<T>, objects: u64, search: &mut impl PacketSearch) {
+        if let Some(bvh) = &self.bvh {
+            let (origin, inverse) = in_float64(ray);
+            return bvh.search_packet(&origin, &inverse, search);
+        }
+        let mut left = objects & self.every_object();
+        while left != 0 && search.active() != 0 {
+            let index = left.trailing_zeros() as usize;
+            left &= left - 1;
+            search.test(index);
+        }
     }
     // ANCHOR_END: nearest_packet
 
-    /// The geometry of object `index`: kept in lanes for a short list, made on the
-    /// spot for the many objects of a BVH.
+    /// `f` of the geometry of object `index`: read where it is kept in lanes (a
+    /// short list), made on the spot for the many objects of a BVH.
     #[inline(always)]
-    fn shape(&self, index: usize) -> Shape4<T> {
+    fn with_shape<R>(&self, index: usize, f: impl FnOnce(&Shape4<T>) -> R) -> R {
         match self.packed.get(index) {
-            Some(p) => p.shape,
-            None => Shape4::new(&self.objects[index]),
+            Some(p) => f(&p.shape),
+            None => f(&Shape4::new(&self.objects[index])),
         }
     }
 

@@ -117,7 +117,7 @@ pub struct Tracer<T: Real = f64> {
     pub packets: bool,
     /// The objects as the packet tracer reads them; empty without packets or with
     /// a BVH.
-    pub packed: Vec<crate::packet::Packed<T>>,
+    pub packed: Vec<Packed<T>>,
 }
 
 /// Half an 8-bit step: a path whose remaining segments cannot add this much to

@@ -94,12 +94,18 @@ pub fn terms<T: Real>(
 /// than the general `powf` and within a few units in the last place of it.
 #[inline]
 pub fn power<T: Real>(x: T, e: T) -> T {
-    let whole = e.to_f64();
-    if whole.fract() == 0.0 && (0.0..=256.0).contains(&whole) {
-        x.powi(whole as i32)
-    } else {
-        x.powf(e)
+    match whole_exponent(e) {
+        Some(n) => x.powi(n as i32),
+        None => x.powf(e),
     }
+}
+
+/// The exponent `e` as a whole number from 0 to 256, when [`power`] takes `powi`
+/// for it.
+#[inline]
+pub fn whole_exponent<T: Real>(e: T) -> Option<u32> {
+    let e = e.to_f64();
+    (e.fract() == 0.0 && (0.0..=256.0).contains(&e)).then_some(e as u32)
 }
 
 #[cfg(test)]
