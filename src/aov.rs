@@ -122,11 +122,15 @@ pub struct FirstHit {
 /// The `object` of a pixel whose primary ray hit nothing.
 pub const NO_OBJECT: u32 = u32::MAX;
 
+/// The size of a [`PixelRecord`]: 13 numbers of 4 bytes (checked when compiled).
+pub const RECORD_BYTES: usize = 52;
+const _: () = assert!(std::mem::size_of::<PixelRecord>() == RECORD_BYTES);
+
 /// Everything the render keeps of one pixel, in float32: enough for every buffer
 /// but `direction`, which the camera gives again for any pixel
 /// ([`Frame::direction`]). The Blinn-Phong terms are kept as their factors `L·N`
 /// and `(N·H)^(shininess/4)`; the colours they multiply are the object's
-/// ([`Frame::term_colours`]). 48 bytes.
+/// ([`Frame::term_colours`]). 52 bytes ([`RECORD_BYTES`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PixelRecord {
     /// The beauty colour, clipped to [0, 1].
