@@ -267,14 +267,14 @@ fn remove_abandoned_temporaries(dir: &Path) {
 pub fn visualise(frame: &Frame, buffer: Buffer) -> Vec<u8> {
     // Each statistic is a pass over the whole frame (100 MB at 1920 × 1080), so
     // only the buffer that shows it computes it.
-    let most = |count: fn(&PixelRecord) -> u32| frame.pixels.par_iter().map(count).max();
+    let largest = |count: fn(&PixelRecord) -> u32| frame.pixels.par_iter().map(count).max();
     let (nearest, most) = match buffer {
         Buffer::Depth => {
             let depths = frame.pixels.par_iter().map(|p| p.depth);
             (depths.reduce(|| f32::INFINITY, f32::min), 0)
         }
-        Buffer::Bounces => (0.0, most(|p| p.bounces).unwrap_or(0)),
-        Buffer::Rays => (0.0, most(|p| p.rays).unwrap_or(0)),
+        Buffer::Bounces => (0.0, largest(|p| p.bounces).unwrap_or(0)),
+        Buffer::Rays => (0.0, largest(|p| p.rays).unwrap_or(0)),
         _ => (0.0, 0),
     };
     picture(frame, |row, col, p| match buffer {
@@ -393,8 +393,9 @@ pub fn exr_to<W: Write + Seek>(frame: &Frame, writer: W) -> exr::error::UnitResu
     let size = (frame.width as usize, frame.height as usize);
     // Uncompressed. Float buffers barely compress, and exr's compressors are
     // slow on them: at 1920 × 1080 (23 channels, 191 MB of samples) RLE saved 42 %
-    // of the file (110 MB) at 0.25 s more on 2 cores, ZIP 74 % (50 MB) at about
-    // 1.1 s more (measured with raystep's release build, 2026-12-01).
+    // of the file (110 MB) at about 0.3 s more per render on 2 cores, ZIP 74 %
+    // (50 MB) at about 1.1 s more (measured with raystep's release build,
+    // 2026-12-01).
     // Scan lines in increasing order keep the bytes the same on every run.
     let encoding = Encoding {
         compression: Compression::Uncompressed,

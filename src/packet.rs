@@ -435,19 +435,17 @@ impl<T: Real> Tracer<T> {
             return total;
         }
         let candidates = self.masks.mask(row, col);
-        let mut centre = Traced4::blank();
-        self.trace_packet(ray, lanes, candidates, &mut centre);
+        let centre = self.trace_packet(ray, lanes, candidates);
         let mut colour = centre.colours();
         let mut rays = centre.rays();
         if self.spp > 1 {
             // Several samples: the mean colour; the buffers keep the centre ray's.
             let mut sum = [Vec3::ZERO; WIDTH];
-            let mut traced = Traced4::blank();
             for sample in 0..self.spp {
                 let at: [(f64, f64); WIDTH] =
                     std::array::from_fn(|i| stratified(row, cols[i] as u32, sample, self.spp));
                 let ray = self.rays_through(at.map(|a| a.0), at.map(|a| a.1));
-                self.trace_packet(ray, lanes, candidates, &mut traced);
+                let traced = self.trace_packet(ray, lanes, candidates);
                 for (i, (c, r)) in traced.colours().into_iter().zip(traced.rays()).enumerate() {
                     sum[i] += c;
                     rays[i] += r;
@@ -495,19 +493,13 @@ impl<T: Real> Tracer<T> {
     // ANCHOR: trace_packet
     /// [`Tracer::trace`] for the four rays of `primary`, of which the lanes `lanes`
     /// count.
-    fn trace_packet(
-        &self,
-        mut ray: Packet<T>,
-        lanes: u32,
-        candidates: u64,
-        traced: &mut Traced4<T>,
-    ) {
+    fn trace_packet(&self, mut ray: Packet<T>, lanes: u32, candidates: u64) -> Traced4<T> {
         let segments = if self.stages.reflection {
             self.max_depth
         } else {
             1
         };
-        *traced = Traced4::blank();
+        let mut traced = Traced4::blank();
         let mut weight = T::Lanes::splat(T::of(1.0));
         let light = V3::<T>::splat(self.light.position);
         let mut alive = lanes; // the lanes whose path goes on
@@ -615,6 +607,7 @@ impl<T: Real> Tracer<T> {
                 }
             }
         }
+        traced
     }
     // ANCHOR_END: trace_packet
 
