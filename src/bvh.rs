@@ -16,10 +16,13 @@
 //!
 //! The result is the plain loop's: the same object at the same distance, ties
 //! going to the lower index as the plain loop's strict `<` gives them (a test
-//! renders both ways and compares the bytes). Boxes are computed in float64 and
-//! widened by a relative 1e-9, far more than their rounding.
+//! renders both ways and compares the bytes). Boxes are computed in float64,
+//! widened by a relative 1e-9, far more than their rounding, then widened once
+//! more and kept in float32, rounded outwards ([`Bvh::build`]): the one-ray walk
+//! tests them in float64, and four rays test them in float32, half the work of
+//! float64 lanes (`Bvh::enter_packet`). A node is 32 bytes, two to a cache line.
 
-use crate::lanes::{F64s, Lanes, V3};
+use crate::lanes::{F64s, Lanes, ALL, V3};
 use crate::ray::Ray;
 use crate::real::{Real, Vector};
 use crate::scene::{consider, Hit, Object, Role, Shape};
@@ -29,11 +32,12 @@ use crate::Vec3;
 /// Most spheres in a leaf.
 pub const LEAF: usize = 4;
 
-/// One node: a box, and either two children or a run of objects.
+/// One node: a box (in float32, rounded outwards), and either two children or a
+/// run of objects.
 #[derive(Clone, Copy, Debug)]
 struct Node {
-    min: Vec3,
-    max: Vec3,
+    min: glam::Vec3,
+    max: glam::Vec3,
     /// Leaf: the first of its objects in `items`. Inner node: its second child
     /// (the first is the next node).
     first: u32,
@@ -52,7 +56,17 @@ pub struct Bvh {
     balls: Vec<[f64; 4]>,
     /// Objects outside the tree, tested for every ray.
     loose: Vec<u32>,
+    /// Rays whose origin has no coordinate larger than this (in size) may test
+    /// the boxes in float32: twice the largest coordinate of the root box (rounded
+    /// down to float32).
+    fast_reach: f32,
 }
+
+/// How much farther than their float64 boxes the stored boxes reach, in units of
+/// float32's unit roundoff times [`Bvh::fast_reach`]: enough that a float32 box
+/// test of a ray from within that reach never misses a box the exact ray enters
+/// (see [`Bvh::enter_packet`]).
+const FAST_PAD: f64 = 32.0;
 
 /// A sphere while the tree is built: its index, box and box centre.
 #[derive(Clone, Copy)]
@@ -68,7 +82,8 @@ impl Bvh {
     /// Build the hierarchy over the `[[sphere]]` objects of `objects`. `extent`
     /// is the largest coordinate any ray may start from or reach (the camera, the
     /// light, every object): boxes are widened by 64·u·`extent`, more than the
-    /// rounding of the stable intersection test in precision `T` can move a hit.
+    /// rounding of the stable intersection test in precision `T` can move a hit,
+    /// and then by what the packet walk's float32 test needs (`FAST_PAD`).
     /// (The textbook quadratic's rounding can report hits far outside a sphere; a
     /// box would hide them and change the picture, so the tracer uses no BVH with
     /// `--intersect naive`.)
@@ -92,20 +107,28 @@ impl Bvh {
                 _ => loose.push(i as u32),
             }
         }
+        let largest = items.iter().fold(0.0f64, |m, i| {
+            m.max(i.min.abs().max_element())
+                .max(i.max.abs().max_element())
+        });
+        let fast_reach = below(2.0 * largest);
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(2 * items.len() / LEAF + 1),
             items: Vec::with_capacity(items.len()),
             balls: Vec::with_capacity(items.len()),
             loose,
+            fast_reach,
         };
+        let widen = FAST_PAD * f64::from(f32::EPSILON / 2.0) * f64::from(fast_reach);
         if !items.is_empty() {
-            bvh.split(&mut items);
+            bvh.split(&mut items, widen);
         }
         bvh
     }
 
-    /// Add the subtree of `items` (depth first) and return its node's index.
-    fn split(&mut self, items: &mut [Item]) -> usize {
+    /// Add the subtree of `items` (depth first) and return its node's index. Its
+    /// box is widened by `widen` and rounded outwards to float32.
+    fn split(&mut self, items: &mut [Item], widen: f64) -> usize {
         let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
         let (mut low, mut high) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
         for item in items.iter() {
@@ -114,8 +137,8 @@ impl Bvh {
         }
         let at = self.nodes.len();
         self.nodes.push(Node {
-            min,
-            max,
+            min: (min - widen).to_array().map(below).into(),
+            max: (max + widen).to_array().map(above).into(),
             first: self.items.len() as u32,
             count: items.len() as u32,
         });
@@ -140,8 +163,8 @@ impl Bvh {
                 .then(a.index.cmp(&b.index))
         });
         let (left, right) = items.split_at_mut(middle);
-        self.split(left);
-        let second = self.split(right);
+        self.split(left, widen);
+        let second = self.split(right, widen);
         self.nodes[at].first = second as u32;
         self.nodes[at].count = 0;
         at
@@ -163,8 +186,8 @@ impl Bvh {
     /// Where `ray` enters the box of `node`, if it does before `limit`.
     #[inline]
     fn enter(node: &Node, origin: Vec3, inverse: Vec3, limit: f64) -> Option<f64> {
-        let t1 = (node.min - origin) * inverse;
-        let t2 = (node.max - origin) * inverse;
+        let t1 = (node.min.as_dvec3() - origin) * inverse;
+        let t2 = (node.max.as_dvec3() - origin) * inverse;
         // A direction component of 0 makes that axis's slab ±∞ (the ray is inside
         // the slab for ever, or never); `f64::min` and `max` skip the NaN of
         // 0 · ∞, a ray exactly in a face plane.
@@ -325,36 +348,89 @@ pub trait PacketSearch {
     fn test_sphere(&mut self, index: usize, ball: &[f64; 4]);
 }
 
+/// The largest float32 not above `x`.
+fn below(x: f64) -> f32 {
+    let r = x as f32;
+    if f64::from(r) <= x {
+        r
+    } else if r > 0.0 {
+        // One step down (what `f32::next_down` does, from Rust 1.86 on).
+        f32::from_bits(r.to_bits() - 1)
+    } else if r < 0.0 {
+        f32::from_bits(r.to_bits() + 1)
+    } else {
+        -f32::from_bits(1)
+    }
+}
+
+/// The smallest float32 not below `x`.
+fn above(x: f64) -> f32 {
+    -below(-x)
+}
+
+/// Float32 lanes.
+type F32s = <f32 as Real>::Lanes;
+
 impl Bvh {
-    /// [`Bvh::enter`] for four rays at once: where each enters the box of `node`,
-    /// and the lanes that enter it before their limit.
+    // ANCHOR: enter_packet
+    /// [`Bvh::enter`] for four rays at once, in precision `L`: where each enters
+    /// the box of `node`, and the lanes that enter it before their limit.
+    ///
+    /// In float32 the origin, the direction, its reciprocal and each step of the
+    /// slab test round, and a box might seem missed by a ray that grazes it. The
+    /// stored boxes reach `32·u·R` past the float64 ones (u = 2⁻²⁴ is float32's
+    /// unit roundoff, R is [`Bvh::fast_reach`]), and [`Bvh::search_packet`] takes
+    /// this path only for rays whose origin coordinates are at most R in size.
+    /// Rounding the origin moves it by at most `u·R`; the slab value
+    /// `(b − o)·(1/d)` then comes out within four roundings of the exact one, an
+    /// error of at most `4u·|b − o| ≤ 4u·1.5R` along the axis (faces lie within
+    /// R/2). Both together are less than the `32u·R` the faces were moved out, so
+    /// a lane that enters the exact box also enters the stored one, at a smaller
+    /// `t`, and its limit is rounded up ([`up_to_f32`]). The unit test
+    /// `a_float32_box_test_enters_every_box_the_exact_ray_enters` fails with
+    /// faces moved out by `2u·R`.
+    ///
+    /// The minima and maxima need not care for NaNs: one comes only from `0·∞`,
+    /// an origin exactly on a stored face with the direction parallel to it, and
+    /// such a ray passes `32u·R` outside the exact box, which any answer skips
+    /// rightly or visits in vain.
     #[inline(always)]
-    fn enter_packet(node: &Node, origin: &V3<f64>, inverse: &V3<f64>, limit: F64s) -> (F64s, u32) {
-        let slab = |min: f64, max: f64, o: F64s, inv: F64s| {
-            let t1 = (F64s::splat(min) - o) * inv;
-            let t2 = (F64s::splat(max) - o) * inv;
-            (t1.min(t2), t1.max(t2))
+    fn enter_packet<L: Real>(
+        node: &Node,
+        origin: &V3<L>,
+        inverse: &V3<L>,
+        limit: L::Lanes,
+    ) -> (L::Lanes, u32) {
+        let slab = |min: f32, max: f32, o: L::Lanes, inv: L::Lanes| {
+            let face = |b: f32| L::Lanes::splat(L::of(f64::from(b)));
+            let t1 = (face(min) - o) * inv;
+            let t2 = (face(max) - o) * inv;
+            (t1.fast_min(t2), t1.fast_max(t2))
         };
         let (nx, fx) = slab(node.min.x, node.max.x, origin.x, inverse.x);
         let (ny, fy) = slab(node.min.y, node.max.y, origin.y, inverse.y);
         let (nz, fz) = slab(node.min.z, node.max.z, origin.z, inverse.z);
-        let near = nx.max(ny).max(nz).max(F64s::splat(0.0));
-        let far = fx.min(fy).min(fz);
+        let near = nx
+            .fast_max(ny)
+            .fast_max(nz)
+            .fast_max(L::Lanes::splat(L::of(0.0)));
+        let far = fx.fast_min(fy).fast_min(fz);
         (near, (far.ge(near) & limit.ge(near)).bits())
     }
+    // ANCHOR_END: enter_packet
 
-    /// Walk the tree with four rays from `origin` along directions whose
-    /// reciprocals are `inverse` (in float64, as [`Bvh::nearest_hit`] computes
-    /// them): every object outside the tree, then every object of every leaf whose
-    /// box some lane still searching enters before its limit. A lane's result is
-    /// the one-ray walk's, because a lane skips only boxes that cannot hold a hit
-    /// as near as its limit; objects it did not need are tested too, and cannot
-    /// come nearer. Children are visited nearer first for the lowest lane that
-    /// enters both (the first child first if no lane enters both).
-    pub fn search_packet<S: PacketSearch>(
+    // ANCHOR: search_packet
+    /// Walk the tree with four rays from `origin` along `direction`: every object
+    /// outside the tree, then every object of every leaf whose box some lane still
+    /// searching enters before its limit. A lane's result is the one-ray walk's,
+    /// because a lane skips only boxes that cannot hold a hit as near as its
+    /// limit; objects it did not need are tested too, and cannot come nearer. The
+    /// boxes are tested in float32 when every origin lies within
+    /// `Bvh::fast_reach` (see `Bvh::enter_packet`), in float64 otherwise.
+    pub fn search_packet<T: Real, S: PacketSearch>(
         &self,
-        origin: &V3<f64>,
-        inverse: &V3<f64>,
+        origin: &V3<T>,
+        direction: &V3<T>,
         search: &mut S,
     ) {
         for &i in &self.loose {
@@ -363,12 +439,44 @@ impl Bvh {
         if self.nodes.is_empty() {
             return;
         }
-        let limits = |search: &S| (search.active(), search.limits());
-        let enters = |node: usize, (active, limit): (u32, F64s)| {
+        let reach = T::Lanes::splat(T::of(f64::from(self.fast_reach)));
+        if reach.ge(origin.max_abs()).bits() == ALL {
+            let f32s = |l: T::Lanes| F32s::from_array(l.to_array().map(|x| x.to_f64() as f32));
+            let v = |v: &V3<T>| V3::<f32>::new(f32s(v.x), f32s(v.y), f32s(v.z));
+            let (o, d) = (v(origin), v(direction));
+            let one = F32s::splat(1.0);
+            let inverse = V3::new(one / d.x, one / d.y, one / d.z);
+            self.walk(&o, &inverse, search, up_to_f32);
+        } else {
+            let f64s = |l: T::Lanes| F64s::from_array(l.to_array().map(Real::to_f64));
+            let v = |v: &V3<T>| V3::<f64>::new(f64s(v.x), f64s(v.y), f64s(v.z));
+            let (o, d) = (v(origin), v(direction));
+            let one = F64s::splat(1.0);
+            let inverse = V3::new(one / d.x, one / d.y, one / d.z);
+            self.walk(&o, &inverse, search, |l| l);
+        }
+    }
+    // ANCHOR_END: search_packet
+
+    /// The walk of [`Bvh::search_packet`], testing boxes in precision `L`, with
+    /// the search's limits converted by `limits_in`.
+    #[inline(always)]
+    fn walk<L: Real, S: PacketSearch>(
+        &self,
+        origin: &V3<L>,
+        inverse: &V3<L>,
+        search: &mut S,
+        limits_in: impl Fn(F64s) -> L::Lanes,
+    ) {
+        // The lanes still searching and their limits change only when a leaf's
+        // objects are tested.
+        let limits = |search: &S| (search.active(), limits_in(search.limits()));
+        let enters = |node: usize, (active, limit): (u32, L::Lanes)| {
             let (near, bits) = Self::enter_packet(&self.nodes[node], origin, inverse, limit);
             (near, bits & active)
         };
-        if enters(0, limits(search)).1 == 0 {
+        let mut now = limits(search);
+        if enters(0, now).1 == 0 {
             return;
         }
         let mut stack = [0u32; 64];
@@ -380,12 +488,14 @@ impl Bvh {
                 for k in n.first as usize..(n.first + n.count) as usize {
                     search.test_sphere(self.items[k] as usize, &self.balls[k]);
                 }
+                now = limits(search);
             } else {
                 let (a, b) = (node + 1, n.first as usize);
-                let limits = limits(search);
-                let (ta, ma) = enters(a, limits);
-                let (tb, mb) = enters(b, limits);
+                let (ta, ma) = enters(a, now);
+                let (tb, mb) = enters(b, now);
                 if ma != 0 && mb != 0 {
+                    // Nearer first for the lowest lane that enters both (the
+                    // first child first if no lane enters both).
                     let both = ma & mb;
                     let lane = both.trailing_zeros() as usize;
                     let a_first = both == 0 || ta.to_array()[lane] <= tb.to_array()[lane];
@@ -407,13 +517,22 @@ impl Bvh {
                 }
                 depth -= 1;
                 let candidate = stack[depth] as usize;
-                if enters(candidate, limits(search)).1 != 0 {
+                if enters(candidate, now).1 != 0 {
                     node = candidate;
                     break;
                 }
             }
         }
     }
+}
+
+/// Distances in float32, each at least the float64 one: rounded to nearest, then
+/// multiplied by 1 + 2⁻²³, which lifts a float32 `r` to at least the next one up
+/// (`r·2⁻²³` is at least its spacing), so `x` below `r`'s upper neighbour is
+/// covered. Infinity stays infinite.
+fn up_to_f32(l: F64s) -> F32s {
+    let up = F32s::splat(1.0 + f32::EPSILON);
+    F32s::from_array(l.to_array().map(|x| x as f32)) * up
 }
 
 #[cfg(test)]
@@ -479,5 +598,97 @@ mod tests {
         assert!((hit.t - 1.6).abs() < 1e-12);
         assert!(bvh.blocked(&objects, &ray, 1.7, Method::Stable));
         assert!(!bvh.blocked(&objects, &ray, 1.5, Method::Stable));
+    }
+
+    #[test]
+    fn outward_rounding_brackets_the_float64_value() {
+        for x in [
+            0.1,
+            -0.1,
+            1e-50,
+            -1e-50,
+            0.0,
+            3.0,
+            -3.0,
+            1e39,
+            16777217.0,
+            -16777217.0,
+        ] {
+            let (lo, hi) = (below(x), above(x));
+            assert!(f64::from(lo) <= x && x <= f64::from(hi), "{x}: {lo} {hi}");
+            // Equal where x is a float32, else neighbours: no float32 between.
+            let middle = ((f64::from(lo) + f64::from(hi)) / 2.0) as f32;
+            assert!(middle == lo || middle == hi, "{x}: {lo} {hi}");
+        }
+    }
+
+    /// The float64 slab test of [`Bvh::enter`] on the box `min`..`max`.
+    fn enters_exact(min: Vec3, max: Vec3, origin: Vec3, direction: Vec3) -> Option<f64> {
+        let inverse = Vec3::ONE / direction;
+        let (t1, t2) = ((min - origin) * inverse, (max - origin) * inverse);
+        let near = t1.min(t2).max_element().max(0.0);
+        let far = t1.max(t2).min_element();
+        (near <= far).then_some(near)
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(
+            std::env::var("RAYSTEP_PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(4000)
+        ))]
+
+        /// The float32 box test of the packet walk never skips a sphere's box that
+        /// the float64 test enters, for rays that graze the box's faces, edges and
+        /// corners, from anywhere within the fast reach, at scales from 10⁻³ to 10⁴;
+        /// nor does the packet walk's float64 test of the stored boxes.
+        #[test]
+        fn a_float32_box_test_enters_every_box_the_exact_ray_enters(
+            scale in -3.0f64..4.0,
+            far in 0.0f64..1.0,
+            centre in proptest::array::uniform3(-1.0f64..1.0),
+            size in 0.001f64..1.0,
+            from in proptest::array::uniform3(-1.0f64..1.0),
+            on in proptest::array::uniform3(0.0f64..1.0),
+            face in 0usize..6,
+            edge in proptest::bool::ANY,
+        ) {
+            let s = 10f64.powf(scale);
+            let c = Vec3::from(centre) * s * 10f64.powf(far);
+            let r = s * size;
+            let objects = [ball(c.x, c.y, c.z, r)];
+            let bvh = Bvh::build(&objects, c.abs().max_element() + r);
+            // A point on the sphere's tight box: on one face, or on an edge of it.
+            let (min, max) = (c - r, c + r);
+            let mut p = min + (max - min) * Vec3::from(on);
+            let axis = face % 3;
+            p[axis] = if face < 3 { min[axis] } else { max[axis] };
+            if edge {
+                let other = (axis + 1) % 3;
+                p[other] = if on[0] < 0.5 { min[other] } else { max[other] };
+            }
+            let origin = Vec3::from(from) * f64::from(bvh.fast_reach);
+            let direction = (p - origin).normalize();
+            proptest::prop_assume!(direction.is_finite());
+            let Some(t) = enters_exact(min, max, origin, direction) else {
+                return Ok(()); // rounded out of the box in float64: nothing to check
+            };
+            let lanes = |v: Vec3| V3::<f32>::new(
+                F32s::splat(v.x as f32), F32s::splat(v.y as f32), F32s::splat(v.z as f32),
+            );
+            // As the walk makes them: the reciprocal of the float32 direction.
+            let (o, d) = (lanes(origin), lanes(direction));
+            let one = F32s::splat(1.0);
+            let inverse = V3::new(one / d.x, one / d.y, one / d.z);
+            // The tightest limit: the exact ray's own entry distance.
+            let limit = up_to_f32(F64s::splat(t));
+            let (near, bits) = Bvh::enter_packet(&bvh.nodes[0], &o, &inverse, limit);
+            proptest::prop_assert_eq!(bits, ALL, "t = {}", t);
+            proptest::prop_assert!(f64::from(near.to_array()[0]) <= t);
+            // The float64 lanes, which rays from farther away take, too.
+            let wide = |v: Vec3| V3::<f64>::splat(v);
+            let (o, inverse) = (wide(origin), wide(Vec3::ONE / direction));
+            let (near, bits) = Bvh::enter_packet(&bvh.nodes[0], &o, &inverse, F64s::splat(t));
+            proptest::prop_assert_eq!(bits, ALL, "t = {}", t);
+            proptest::prop_assert!(near.to_array()[0] <= t);
+        }
     }
 }

@@ -58,6 +58,12 @@ pub trait Lanes<T: Real>:
     fn min(self, other: Self) -> Self;
     /// The larger of two, lane by lane (as [`Real::max`]: a NaN gives the other).
     fn max(self, other: Self) -> Self;
+    /// The smaller of two, lane by lane, where neither is a NaN (a lane with a NaN
+    /// may come out as either): one instruction, where [`Lanes::min`] takes four.
+    fn fast_min(self, other: Self) -> Self;
+    /// The larger of two, lane by lane, where neither is a NaN (see
+    /// [`Lanes::fast_min`]).
+    fn fast_max(self, other: Self) -> Self;
     /// Absolute value of each lane.
     fn abs(self) -> Self;
     /// Mask of `self > other`.
@@ -102,6 +108,14 @@ macro_rules! lanes {
             #[inline(always)]
             fn max(self, other: Self) -> Self {
                 <$w>::max(self, other)
+            }
+            #[inline(always)]
+            fn fast_min(self, other: Self) -> Self {
+                <$w>::fast_min(self, other)
+            }
+            #[inline(always)]
+            fn fast_max(self, other: Self) -> Self {
+                <$w>::fast_max(self, other)
             }
             #[inline(always)]
             fn abs(self) -> Self {

@@ -135,26 +135,43 @@ impl<T: Real> Shape4<T> {
 impl<T: Real> Packed<T> {
     /// The numbers of `object` lit by `light`.
     pub fn new(object: &Object<T>, light: &Light<T>) -> Packed<T> {
-        let m = &object.material;
-        let radius = match object.shape {
-            Shape::Sphere(s) => s.radius,
-            Shape::Plane(_) => T::of(0.0),
-        };
-        let exponent = m.shininess / T::of(4.0);
-        let whole = whole_exponent(exponent);
-        let lanes = T::Lanes::splat;
+        Packed::gather([object; WIDTH], light)
+    }
+
+    /// The numbers of `objects[i]` lit by `light` in lane `i`: what
+    /// [`Packed::blend`] makes of the four objects' [`Packed::new`], without
+    /// making four whole ones first (for the many objects of a BVH, which are
+    /// not kept in lanes).
+    fn gather(objects: [&Object<T>; WIDTH], light: &Light<T>) -> Packed<T> {
+        let n = T::Lanes::from_array;
+        let v = V3::<T>::from_vectors;
+        let zero = T::of(0.0);
+        // Each object's geometry: sphere or not, centre or point, normal, radius.
+        let shape = objects.map(|o| match o.shape {
+            Shape::Sphere(s) => (true, s.center, T::Vec3::ZERO, s.radius),
+            Shape::Plane(p) => (false, p.point, p.normal, zero),
+        });
+        let material = objects.map(|o| &o.material);
+        let exponent = material.map(|m| m.shininess / T::of(4.0));
+        let whole = exponent.map(whole_exponent);
+        let lanes = |bits: [bool; WIDTH]| (0..WIDTH).fold(0, |m, i| m | u32::from(bits[i]) << i);
         Packed {
-            shape: Shape4::new(object),
-            radius: lanes(radius),
-            magnitude: lanes(object.magnitude()),
-            ambient: V3::splat(m.ambient * light.ambient),
-            diffuse_light: V3::splat(m.diffuse * light.diffuse),
-            specular_light: V3::splat(m.specular * light.specular),
-            diffuse: V3::splat(m.diffuse),
-            exponent: lanes(exponent),
-            whole: [whole.unwrap_or(0); WIDTH],
-            fractional: if whole.is_some() { 0 } else { ALL },
-            reflection: lanes(m.reflection),
+            shape: Shape4 {
+                spheres: lanes(shape.map(|s| s.0)),
+                point: v(shape.map(|s| s.1)),
+                normal: v(shape.map(|s| s.2)),
+                radius_squared: n(shape.map(|s| s.3 * s.3)),
+            },
+            radius: n(shape.map(|s| s.3)),
+            magnitude: n(objects.map(Object::magnitude)),
+            ambient: v(material.map(|m| m.ambient * light.ambient)),
+            diffuse_light: v(material.map(|m| m.diffuse * light.diffuse)),
+            specular_light: v(material.map(|m| m.specular * light.specular)),
+            diffuse: v(material.map(|m| m.diffuse)),
+            exponent: n(exponent),
+            whole: whole.map(|w| w.unwrap_or(0)),
+            fractional: lanes(whole.map(|w| w.is_none())),
+            reflection: n(material.map(|m| m.reflection)),
         }
     }
 
@@ -383,16 +400,6 @@ fn in_f64<T: Real>(l: T::Lanes) -> F64s {
     F64s::from_array(l.to_array().map(|x| x.to_f64()))
 }
 
-/// The rays' origins and the reciprocals of their directions in float64, as the
-/// BVH's box test takes them.
-#[inline(always)]
-fn in_float64<T: Real>(ray: &Packet<T>) -> (V3<f64>, V3<f64>) {
-    let v = |v: &V3<T>| V3::<f64>::new(in_f64::<T>(v.x), in_f64::<T>(v.y), in_f64::<T>(v.z));
-    let one = F64s::splat(1.0);
-    let d = v(&ray.direction);
-    (v(&ray.origin), V3::new(one / d.x, one / d.y, one / d.z))
-}
-
 /// The lanes `bits` as indices.
 #[inline(always)]
 fn lanes_of(bits: u32) -> impl Iterator<Item = usize> {
@@ -515,20 +522,20 @@ impl<T: Real> Tracer<T> {
                 break;
             }
             let made;
-            let object = match (self.same_object(&which, alive), self.bvh.is_some()) {
-                (Some(index), false) => &self.packed[index],
-                // The many objects of a BVH are not kept in lanes: made for the hit.
-                (Some(index), true) => {
-                    made = Packed::new(&self.objects[index], &self.light);
-                    &made
-                }
-                (None, false) => {
+            let object = match (self.bvh.is_some(), self.same_object(&which, alive)) {
+                (false, Some(index)) => &self.packed[index],
+                (false, None) => {
                     made = Packed::blend(which.map(|w| &self.packed[w]));
                     &made
                 }
-                (None, true) => {
-                    let each = which.map(|w| Packed::new(&self.objects[w], &self.light));
-                    made = Packed::blend(std::array::from_fn(|i| &each[i]));
+                // The many objects of a BVH are not kept in lanes: made for the hit
+                // (read for the lanes alive only, when they hit one object).
+                (true, Some(index)) => {
+                    made = Packed::new(&self.objects[index], &self.light);
+                    &made
+                }
+                (true, None) => {
+                    made = Packed::gather(which.map(|w| &self.objects[w]), &self.light);
                     &made
                 }
             };
@@ -663,8 +670,7 @@ impl<T: Real> Tracer<T> {
     #[inline(always)]
     fn search_packet(&self, ray: &Packet<T>, objects: u64, search: &mut impl PacketSearch) {
         if let Some(bvh) = &self.bvh {
-            let (origin, inverse) = in_float64(ray);
-            return bvh.search_packet(&origin, &inverse, search);
+            return bvh.search_packet(&ray.origin, &ray.direction, search);
         }
         let mut left = objects & self.every_object();
         while left != 0 && search.active() != 0 {
