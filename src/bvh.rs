@@ -23,7 +23,7 @@
 //! float64 lanes, unless a ray starts too far out (`Bvh::enter_packet`). A node is
 //! 32 bytes, two to a cache line.
 
-use crate::lanes::{F64s, Lanes, ALL, V3};
+use crate::lanes::{convert, F32s, F64s, Lanes, ALL, V3};
 use crate::ray::Ray;
 use crate::real::{Real, Vector};
 use crate::scene::{consider, Hit, Object, Role, Shape};
@@ -114,13 +114,10 @@ impl Bvh {
             m.max(i.min.abs().max_element())
                 .max(i.max.abs().max_element())
         });
+        let reach = 2.0 * largest;
         // Below float32's normal numbers the rounding of an origin is not relative
         // (and the bound of `enter_packet` fails): such a tree is walked in float64.
-        let fast_reach = if largest < 1e-30 {
-            -1.0
-        } else {
-            below(2.0 * largest)
-        };
+        let fast_reach = if largest < 1e-30 { -1.0 } else { below(reach) };
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(2 * items.len() / LEAF + 1),
             items: Vec::with_capacity(items.len()),
@@ -128,7 +125,7 @@ impl Bvh {
             loose,
             fast_reach,
         };
-        let widen = FAST_PAD * f64::from(f32::EPSILON / 2.0) * f64::from(fast_reach);
+        let widen = FAST_PAD * f64::from(f32::EPSILON / 2.0) * reach;
         if !items.is_empty() {
             bvh.split(&mut items, widen);
         }
@@ -380,9 +377,6 @@ fn above(x: f64) -> f32 {
     -below(-x)
 }
 
-/// Float32 lanes.
-type F32s = <f32 as Real>::Lanes;
-
 impl Bvh {
     // ANCHOR: enter_packet
     /// [`Bvh::enter`] for four rays at once, in precision `L`: where each enters
@@ -455,19 +449,11 @@ impl Bvh {
         }
         let reach = T::Lanes::splat(T::of(f64::from(self.fast_reach)));
         if reach.ge(origin.max_abs()).bits() == ALL {
-            let f32s = |l: T::Lanes| F32s::from_array(l.to_array().map(|x| x.to_f64() as f32));
-            let v = |v: &V3<T>| V3::<f32>::new(f32s(v.x), f32s(v.y), f32s(v.z));
-            let (o, d) = (v(origin), v(direction));
-            let one = F32s::splat(1.0);
-            let inverse = V3::new(one / d.x, one / d.y, one / d.z);
-            self.walk(&o, &inverse, search, up_to_f32);
+            let (o, d) = (origin.convert::<f32>(), direction.convert::<f32>());
+            self.walk(&o, &d, search, up_to_f32);
         } else {
-            let f64s = |l: T::Lanes| F64s::from_array(l.to_array().map(Real::to_f64));
-            let v = |v: &V3<T>| V3::<f64>::new(f64s(v.x), f64s(v.y), f64s(v.z));
-            let (o, d) = (v(origin), v(direction));
-            let one = F64s::splat(1.0);
-            let inverse = V3::new(one / d.x, one / d.y, one / d.z);
-            self.walk(&o, &inverse, search, |l| l);
+            let (o, d) = (origin.convert::<f64>(), direction.convert::<f64>());
+            self.walk(&o, &d, search, |l| l);
         }
     }
     // ANCHOR_END: search_packet
@@ -478,10 +464,13 @@ impl Bvh {
     fn walk<L: Real, S: PacketSearch>(
         &self,
         origin: &V3<L>,
-        inverse: &V3<L>,
+        direction: &V3<L>,
         search: &mut S,
         limits_in: impl Fn(F64s) -> L::Lanes,
     ) {
+        let one = L::Lanes::splat(L::of(1.0));
+        let d = direction;
+        let inverse = &V3::new(one / d.x, one / d.y, one / d.z);
         // The lanes still searching and their limits change only when a leaf's
         // objects are tested.
         let limits = |search: &S| (search.active(), limits_in(search.limits()));
@@ -551,7 +540,7 @@ impl Bvh {
 fn up_to_f32(l: F64s) -> F32s {
     let up = F32s::splat(1.0 + f32::EPSILON);
     let tiny = F32s::splat(f32::from_bits(1));
-    F32s::from_array(l.to_array().map(|x| x as f32)) * up + tiny
+    convert::<f64, f32>(l) * up + tiny
 }
 
 #[cfg(test)]
@@ -713,9 +702,7 @@ mod tests {
             let Some(t) = enters_exact(min, max, origin, direction) else {
                 return Ok(()); // rounded out of the box in float64: nothing to check
             };
-            let lanes = |v: Vec3| V3::<f32>::new(
-                F32s::splat(v.x as f32), F32s::splat(v.y as f32), F32s::splat(v.z as f32),
-            );
+            let lanes = |v: Vec3| V3::<f64>::splat(v).convert::<f32>();
             // As the walk makes them: the reciprocal of the float32 direction.
             let (o, d) = (lanes(origin), lanes(direction));
             let one = F32s::splat(1.0);

@@ -27,9 +27,19 @@ pub const WIDTH: usize = 4;
 /// The bits of every lane.
 pub const ALL: u32 = (1 << WIDTH) - 1;
 
-/// Four numbers of float64 (a packet's box tests are in float64 whatever the
-/// precision, as the one-ray BVH's are).
+/// Four numbers of float64 (the limits of a packet's search, whatever its
+/// precision).
 pub type F64s = <f64 as Real>::Lanes;
+
+/// Four numbers of float32 (the BVH's box tests).
+pub type F32s = <f32 as Real>::Lanes;
+
+/// The lanes `l` in precision `L`: exact into a wider precision, rounded to
+/// nearest into a narrower one.
+#[inline(always)]
+pub fn convert<T: Real, L: Real>(l: T::Lanes) -> L::Lanes {
+    L::Lanes::from_array(l.to_array().map(|x| L::of(x.to_f64())))
+}
 
 /// Four numbers of precision `T` computed together.
 pub trait Lanes<T: Real>:
@@ -181,6 +191,16 @@ impl<T: Real> V3<T> {
     pub fn splat(v: T::Vec3) -> V3<T> {
         let [x, y, z] = components::<T>(v);
         V3::new(T::Lanes::splat(x), T::Lanes::splat(y), T::Lanes::splat(z))
+    }
+
+    /// The vectors in precision `L` ([`convert`] of each coordinate).
+    #[inline(always)]
+    pub fn convert<L: Real>(&self) -> V3<L> {
+        V3::new(
+            convert::<T, L>(self.x),
+            convert::<T, L>(self.y),
+            convert::<T, L>(self.z),
+        )
     }
 
     /// Vector `i` in lane `i`.

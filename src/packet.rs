@@ -36,7 +36,7 @@
 use crate::accel::{EVERY, TILE};
 use crate::aov::{FirstHit, PixelRecord};
 use crate::bvh::PacketSearch;
-use crate::lanes::{powi, F64s, Lanes, ALL, V3, WIDTH};
+use crate::lanes::{convert, powi, F64s, Lanes, ALL, V3, WIDTH};
 use crate::real::{Real, Vector};
 use crate::render::{direction_colour, stratified, Rays, Tracer, HALF_STEP};
 use crate::scene::{Light, Object, Shape};
@@ -120,15 +120,23 @@ impl<T: Real> Shape4<T> {
     /// The geometry of `object`.
     #[inline(always)]
     pub fn new(object: &Object<T>) -> Shape4<T> {
-        match object.shape {
-            Shape::Sphere(s) => Shape4::sphere(s.center, s.radius),
-            Shape::Plane(p) => Shape4 {
-                spheres: 0,
-                point: V3::splat(p.point),
-                normal: V3::splat(p.normal),
-                radius_squared: T::Lanes::splat(T::of(0.0)),
-            },
+        let (sphere, point, normal, radius) = geometry(object);
+        Shape4 {
+            spheres: if sphere { ALL } else { 0 },
+            point: V3::splat(point),
+            normal: V3::splat(normal),
+            radius_squared: T::Lanes::splat(radius * radius),
         }
+    }
+}
+
+/// What [`Shape4`] keeps of `object`: is it a sphere, its centre (or the plane's
+/// point), the plane's normal (zero for a sphere), the radius (zero for a plane).
+#[inline(always)]
+fn geometry<T: Real>(object: &Object<T>) -> (bool, T::Vec3, T::Vec3, T) {
+    match object.shape {
+        Shape::Sphere(s) => (true, s.center, T::Vec3::ZERO, s.radius),
+        Shape::Plane(p) => (false, p.point, p.normal, T::of(0.0)),
     }
 }
 
@@ -145,12 +153,7 @@ impl<T: Real> Packed<T> {
     fn gather(objects: [&Object<T>; WIDTH], light: &Light<T>) -> Packed<T> {
         let n = T::Lanes::from_array;
         let v = V3::<T>::from_vectors;
-        let zero = T::of(0.0);
-        // Each object's geometry: sphere or not, centre or point, normal, radius.
-        let shape = objects.map(|o| match o.shape {
-            Shape::Sphere(s) => (true, s.center, T::Vec3::ZERO, s.radius),
-            Shape::Plane(p) => (false, p.point, p.normal, zero),
-        });
+        let shape = objects.map(geometry);
         let material = objects.map(|o| &o.material);
         let exponent = material.map(|m| m.shininess / T::of(4.0));
         let whole = exponent.map(whole_exponent);
@@ -315,7 +318,7 @@ impl<T: Real> PacketSearch for Nearest<'_, T> {
 
     fn limits(&self) -> F64s {
         let none = F64s::splat(f64::INFINITY);
-        F64s::mask(self.found.bits()).select(in_f64::<T>(self.t), none)
+        F64s::mask(self.found.bits()).select(convert::<T, f64>(self.t), none)
     }
 
     #[inline(always)]
@@ -370,7 +373,7 @@ impl<T: Real> PacketSearch for Blocked<'_, T> {
     }
 
     fn limits(&self) -> F64s {
-        in_f64::<T>(self.distance)
+        convert::<T, f64>(self.distance)
     }
 
     #[inline(always)]
@@ -392,12 +395,6 @@ impl<T: Real> Blocked<'_, T> {
         let (t, hit) = self.tracer.hits(shape, self.ray);
         self.blocked |= (hit & t.lt(self.distance)).bits();
     }
-}
-
-/// The lanes `l` in float64 (exactly).
-#[inline(always)]
-fn in_f64<T: Real>(l: T::Lanes) -> F64s {
-    F64s::from_array(l.to_array().map(|x| x.to_f64()))
 }
 
 /// The lanes `bits` as indices.
