@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use crate::aov::Frame;
 use crate::error::Error;
-use crate::render::{render_into, Rays, Settings};
+use crate::render::{has_avx, render_into, Rays, Settings};
 use crate::scene::Scene;
 use crate::yardstick::Yardstick;
 
@@ -53,6 +53,10 @@ pub struct Report {
     pub yardstick_ratio: Option<f64>,
     /// Peak resident memory of the process so far, in bytes (Linux only).
     pub peak_memory_bytes: Option<u64>,
+    /// The build of the packet tracer that ran: `"avx"` (four float64 lanes to
+    /// a register), `"baseline"` (two, as on any x86-64 processor: SSE2), or
+    /// `"off"` with `--packets off`.
+    pub packets: &'static str,
 }
 
 /// How to bench.
@@ -139,6 +143,11 @@ pub fn bench(
         yardstick_median_s,
         yardstick_ratio: yardstick_median_s.map(|t| t / median_s),
         peak_memory_bytes: peak_memory_bytes(),
+        packets: match (settings.packets, settings.avx && has_avx()) {
+            (false, _) => "off",
+            (true, true) => "avx",
+            (true, false) => "baseline",
+        },
     })
 }
 
@@ -189,6 +198,15 @@ impl Report {
         line(format!(
             "  rays        {:>9} per frame: {} primary, {} shadow, {} reflection",
             self.rays, self.rays_primary, self.rays_shadow, self.rays_reflection
+        ));
+        line(format!(
+            "  packets     {}",
+            match self.packets {
+                "avx" => "four rays at once, the AVX build (4 float64 lanes to a register)",
+                "baseline" =>
+                    "four rays at once, the baseline build (2 float64 lanes to a register)",
+                _ => "off: one ray at a time",
+            }
         ));
         if let (Some(t), Some(s)) = (self.one_thread_median_s, self.thread_speedup) {
             line(format!(

@@ -435,6 +435,7 @@ impl Bvh {
     /// limit; objects it did not need are tested too, and cannot come nearer. The
     /// boxes are tested in float32 when every origin lies within
     /// `Bvh::fast_reach` (see `Bvh::enter_packet`), in float64 otherwise.
+    #[inline(always)]
     pub fn search_packet<T: Real, S: PacketSearch>(
         &self,
         origin: &V3<T>,

@@ -247,6 +247,11 @@ pub struct RuleArgs {
     /// pixel [default: on].
     #[arg(long, value_enum, value_name = "on|off")]
     pub packets: Option<Switch>,
+    /// Where the processor has AVX, run the packet tracer compiled for it (four
+    /// float64 lanes to a register instead of two); never changes a pixel
+    /// [default: on].
+    #[arg(long, value_enum, value_name = "on|off")]
+    pub avx: Option<Switch>,
 }
 
 /// On or off.
@@ -388,6 +393,7 @@ impl RuleArgs {
             spp: self.spp.unwrap_or(base.spp),
             early_stop: self.early_stop.map_or(base.early_stop, |s| s == Switch::On),
             packets: self.packets.map_or(base.packets, |s| s == Switch::On),
+            avx: self.avx.map_or(base.avx, |s| s == Switch::On),
         })
     }
 }

@@ -2,9 +2,10 @@
 //! computes in.
 //!
 //! [`Lanes`] is to four rays what [`Real`] is to one: the few operations the
-//! packet tracer needs, for float64 (wide's `f64x4`, two SSE2 registers on a plain
-//! x86-64 build) and float32 (`f32x4`, one). [`V3`] is a 3-vector whose components
-//! are lanes: four vectors side by side.
+//! packet tracer needs, for float64 ([`F64x4`], a plain array of four that the
+//! compiler turns into two SSE2 registers or one AVX register, whichever the code
+//! is compiled for) and float32 (wide's `f32x4`, one SSE register). [`V3`] is a
+//! 3-vector whose components are lanes: four vectors side by side.
 //!
 //! Every operation here is the IEEE one, rounded once, exactly as the scalar
 //! operation is, and every formula of [`V3`] adds and multiplies in the order glam
@@ -27,6 +28,14 @@ pub const WIDTH: usize = 4;
 /// The bits of every lane.
 pub const ALL: u32 = (1 << WIDTH) - 1;
 
+/// `[f(0), f(1), f(2), f(3)]`: `std::array::from_fn` for the lanes, written
+/// out so that it is always inlined (the packet tracer's AVX build compiles only
+/// what is inlined into it for AVX).
+#[inline(always)]
+pub fn each<R>(mut f: impl FnMut(usize) -> R) -> [R; WIDTH] {
+    [f(0), f(1), f(2), f(3)]
+}
+
 /// Four numbers of float64 (the limits of a packet's search, whatever its
 /// precision).
 pub type F64s = <f64 as Real>::Lanes;
@@ -38,7 +47,8 @@ pub type F32s = <f32 as Real>::Lanes;
 /// nearest into a narrower one.
 #[inline(always)]
 pub fn convert<T: Real, L: Real>(l: T::Lanes) -> L::Lanes {
-    L::Lanes::from_array(l.to_array().map(|x| L::of(x.to_f64())))
+    let l = l.to_array();
+    L::Lanes::from_array(each(|i| L::of(l[i].to_f64())))
 }
 
 /// Four numbers of precision `T` computed together.
@@ -165,8 +175,200 @@ macro_rules! lanes {
     };
 }
 
-lanes!(f64, wide::f64x4, u64);
 lanes!(f32, wide::f32x4, u32);
+
+/// Four float64 numbers as a plain array, each operation written lane by lane.
+///
+/// The compiler turns each of these loops into SIMD instructions as wide as the
+/// function it lands in is compiled for: two SSE2 registers of two lanes on a plain
+/// x86-64 build, one AVX register of four inside
+/// [`Tracer::packet_row`](crate::render::Tracer::packet_row) on a processor that
+/// has AVX (chosen when the program runs), NEON pairs on ARM. The results are the
+/// same in every case: each lane is the IEEE operation, rounded once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(32))]
+pub struct F64x4(pub [f64; WIDTH]);
+
+impl F64x4 {
+    /// `f` of each lane.
+    #[inline(always)]
+    fn map(self, f: impl Fn(f64) -> f64) -> F64x4 {
+        F64x4([f(self.0[0]), f(self.0[1]), f(self.0[2]), f(self.0[3])])
+    }
+
+    /// `f` of each pair of lanes.
+    #[inline(always)]
+    fn zip(self, o: F64x4, f: impl Fn(f64, f64) -> f64) -> F64x4 {
+        let (a, b) = (self.0, o.0);
+        F64x4([f(a[0], b[0]), f(a[1], b[1]), f(a[2], b[2]), f(a[3], b[3])])
+    }
+
+    /// `f` of each pair of lanes' bits.
+    #[inline(always)]
+    fn zip_bits(self, o: F64x4, f: impl Fn(u64, u64) -> u64) -> F64x4 {
+        self.zip(o, |a, b| f64::from_bits(f(a.to_bits(), b.to_bits())))
+    }
+
+    /// The mask of `test` on each pair of lanes. (Written as a negated 0 or 1,
+    /// which the compiler makes one comparison instruction; an `if` would not be.)
+    #[inline(always)]
+    fn test(self, o: F64x4, test: impl Fn(f64, f64) -> bool) -> F64x4 {
+        self.zip(o, |a, b| {
+            f64::from_bits(u64::from(test(a, b)).wrapping_neg())
+        })
+    }
+}
+
+/// The mask of every 4-bit number, for [`Lanes::mask`]: one load.
+static F64_MASKS: [F64x4; 16] = {
+    let mut masks = [F64x4([0.0; WIDTH]); 16];
+    let mut bits = 0;
+    while bits < 16 {
+        let mut i = 0;
+        while i < WIDTH {
+            if bits >> i & 1 == 1 {
+                masks[bits].0[i] = f64::from_bits(u64::MAX);
+            }
+            i += 1;
+        }
+        bits += 1;
+    }
+    masks
+};
+
+macro_rules! f64x4_operator {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl $trait for F64x4 {
+            type Output = F64x4;
+            #[inline(always)]
+            fn $method(self, o: F64x4) -> F64x4 {
+                self.zip(o, |a, b| a $op b)
+            }
+        }
+    };
+}
+
+f64x4_operator!(Add, add, +);
+f64x4_operator!(Sub, sub, -);
+f64x4_operator!(Mul, mul, *);
+f64x4_operator!(Div, div, /);
+
+impl Neg for F64x4 {
+    type Output = F64x4;
+    #[inline(always)]
+    fn neg(self) -> F64x4 {
+        self.map(|a| -a)
+    }
+}
+
+impl BitAnd for F64x4 {
+    type Output = F64x4;
+    #[inline(always)]
+    fn bitand(self, o: F64x4) -> F64x4 {
+        self.zip_bits(o, |a, b| a & b)
+    }
+}
+
+impl BitOr for F64x4 {
+    type Output = F64x4;
+    #[inline(always)]
+    fn bitor(self, o: F64x4) -> F64x4 {
+        self.zip_bits(o, |a, b| a | b)
+    }
+}
+
+impl Not for F64x4 {
+    type Output = F64x4;
+    #[inline(always)]
+    fn not(self) -> F64x4 {
+        self.map(|a| f64::from_bits(!a.to_bits()))
+    }
+}
+
+impl Lanes<f64> for F64x4 {
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        F64x4([x; WIDTH])
+    }
+    #[inline(always)]
+    fn from_array(a: [f64; WIDTH]) -> Self {
+        F64x4(a)
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f64; WIDTH] {
+        self.0
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        self.map(f64::sqrt)
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        // The processor's minimum (`a < b ? a : b`), and the other where `o` is a
+        // NaN: Rust's `f64::min` for every NaN.
+        self.zip(o, |a, b| {
+            let min = if a < b { a } else { b };
+            if b.is_nan() {
+                a
+            } else {
+                min
+            }
+        })
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        self.zip(o, |a, b| {
+            let max = if a > b { a } else { b };
+            if b.is_nan() {
+                a
+            } else {
+                max
+            }
+        })
+    }
+    #[inline(always)]
+    fn fast_min(self, o: Self) -> Self {
+        self.zip(o, |a, b| if a < b { a } else { b })
+    }
+    #[inline(always)]
+    fn fast_max(self, o: Self) -> Self {
+        self.zip(o, |a, b| if a > b { a } else { b })
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        self.map(f64::abs)
+    }
+    #[inline(always)]
+    fn gt(self, o: Self) -> Self {
+        self.test(o, |a, b| a > b)
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> Self {
+        self.test(o, |a, b| a < b)
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> Self {
+        self.test(o, |a, b| a >= b)
+    }
+    #[inline(always)]
+    fn ne(self, o: Self) -> Self {
+        self.test(o, |a, b| a != b)
+    }
+    #[inline(always)]
+    fn select(self, yes: Self, no: Self) -> Self {
+        (self & yes) | (!self & no)
+    }
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    fn bits(self) -> u32 {
+        let sign = |i: usize| (self.0[i].to_bits() >> 63) as u32;
+        sign(0) | sign(1) << 1 | sign(2) << 2 | sign(3) << 3
+    }
+    #[inline(always)]
+    fn mask(bits: u32) -> Self {
+        F64_MASKS[(bits & ALL) as usize]
+    }
+}
 
 /// A 3-vector of lanes of precision `T`: lane `i` of `x`, `y` and `z` is vector `i`.
 #[derive(Clone, Copy, Debug)]
@@ -206,11 +408,11 @@ impl<T: Real> V3<T> {
     /// Vector `i` in lane `i`.
     #[inline(always)]
     pub fn from_vectors(v: [T::Vec3; WIDTH]) -> V3<T> {
-        let c = v.map(components::<T>);
+        let c = each(|i| components::<T>(v[i]));
         V3::new(
-            T::Lanes::from_array(c.map(|c| c[0])),
-            T::Lanes::from_array(c.map(|c| c[1])),
-            T::Lanes::from_array(c.map(|c| c[2])),
+            T::Lanes::from_array(each(|i| c[i][0])),
+            T::Lanes::from_array(each(|i| c[i][1])),
+            T::Lanes::from_array(each(|i| c[i][2])),
         )
     }
 
@@ -218,7 +420,7 @@ impl<T: Real> V3<T> {
     #[inline(always)]
     pub fn to_vectors(self) -> [T::Vec3; WIDTH] {
         let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
-        std::array::from_fn(|i| T::Vec3::new(x[i], y[i], z[i]))
+        each(|i| T::Vec3::new(x[i], y[i], z[i]))
     }
 
     /// Dot product, lane by lane: `x·x' + y·y' + z·z'`, added in that order.
@@ -341,7 +543,7 @@ pub fn powi<T: Real>(x: T::Lanes, n: [u32; WIDTH]) -> T::Lanes {
         if odd != 0 {
             result = T::Lanes::mask(odd).select(result * square, result);
         }
-        n = n.map(|k| k >> 1);
+        n = each(|i| n[i] >> 1);
         if n == [0; WIDTH] {
             return result;
         }
@@ -357,19 +559,19 @@ mod tests {
     #[test]
     fn masks_and_bits_agree() {
         for bits in 0..=ALL {
-            assert_eq!(<wide::f64x4 as Lanes<f64>>::mask(bits).bits(), bits);
+            assert_eq!(<F64x4 as Lanes<f64>>::mask(bits).bits(), bits);
             assert_eq!(<wide::f32x4 as Lanes<f32>>::mask(bits).bits(), bits);
         }
-        let a = wide::f64x4::new([1.0, 2.0, f64::NAN, 4.0]);
-        let b = wide::f64x4::splat(2.0);
+        let a = F64x4::from_array([1.0, 2.0, f64::NAN, 4.0]);
+        let b = <F64x4 as Lanes<f64>>::splat(2.0);
         assert_eq!(Lanes::<f64>::gt(a, b).bits(), 0b1000);
         assert_eq!(Lanes::<f64>::ne(a, b).bits(), 0b1101);
     }
 
     #[test]
     fn min_and_max_treat_a_nan_as_rusts_do() {
-        let a = wide::f64x4::new([f64::NAN, 1.0, 3.0, f64::NAN]);
-        let b = wide::f64x4::new([2.0, f64::NAN, 1.0, f64::NAN]);
+        let a = F64x4::from_array([f64::NAN, 1.0, 3.0, f64::NAN]);
+        let b = F64x4::from_array([2.0, f64::NAN, 1.0, f64::NAN]);
         let (lo, hi) = (
             Lanes::<f64>::min(a, b).to_array(),
             Lanes::<f64>::max(a, b).to_array(),
@@ -413,7 +615,7 @@ mod tests {
         for n in 0..=256u32 {
             // Four exponents, and one exponent in every lane.
             for ns in [[n, (n * 7) % 257, 25, 256 - n], [n; 4]] {
-                let got = powi::<f64>(wide::f64x4::new(xs), ns).to_array();
+                let got = powi::<f64>(F64x4(xs), ns).to_array();
                 let got32 = powi::<f32>(wide::f32x4::new(xs.map(|x| x as f32)), ns).to_array();
                 for i in 0..4 {
                     let x = std::hint::black_box(xs[i]);

@@ -27,16 +27,24 @@
 //! packet are in one of those cases, the square root and the division are not
 //! computed.
 //!
+//! The packet loop is compiled twice, once for any x86-64 processor and once for
+//! one with AVX, whose registers hold four float64 lanes instead of two; which one
+//! runs is chosen when the program runs ([`Tracer::packet_row`], `--avx on|off`).
+//! That is why the functions here are `#[inline(always)]`: only what is inlined
+//! into the AVX build's entry is compiled for AVX. The two give the same bits.
+//!
 //! `--packets on` (the default) traces scenes of up to [`MAX_OBJECTS`] objects by
 //! the plain loop (with the tile masks), and larger ones through the BVH, which a
 //! packet walks together ([`Bvh::search_packet`](crate::bvh::Bvh::search_packet)).
 //! A larger scene without a BVH (`--accel off`, or `--intersect naive`) is traced
 //! one ray at a time.
 
+use std::borrow::Cow;
+
 use crate::accel::{EVERY, TILE};
-use crate::aov::{FirstHit, PixelRecord};
+use crate::aov::{PixelRecord, NO_OBJECT};
 use crate::bvh::PacketSearch;
-use crate::lanes::{convert, powi, F64s, Lanes, ALL, V3, WIDTH};
+use crate::lanes::{convert, each, powi, F64s, Lanes, ALL, V3, WIDTH};
 use crate::real::{Real, Vector};
 use crate::render::{direction_colour, stratified, Rays, Tracer, HALF_STEP};
 use crate::scene::{Light, Object, Shape};
@@ -247,6 +255,7 @@ struct Traced4<T: Real> {
 
 impl<T: Real> Traced4<T> {
     /// Black, no hit, no rays.
+    #[inline(always)]
     fn blank() -> Traced4<T> {
         let zero = T::Lanes::splat(T::of(0.0));
         Traced4 {
@@ -265,31 +274,74 @@ impl<T: Real> Traced4<T> {
     }
 
     /// Each lane's colour, clipped to [0, 1].
+    #[inline(always)]
     fn colours(&self) -> [Vec3; WIDTH] {
-        self.colour.to_vectors().map(|c| c.clamp01().to_f64())
+        let c = self.colour.to_vectors();
+        each(|i| c[i].clamp01().to_f64())
     }
 
-    /// Each lane's first hit, as [`Tracer::trace`] records it.
-    fn firsts(&self) -> [Option<FirstHit>; WIDTH] {
-        let (depth, normal) = (self.depth.to_array(), self.normal.to_vectors());
-        let (l_dot_n, highlight) = (self.l_dot_n.to_array(), self.highlight.to_array());
-        std::array::from_fn(|i| {
+    /// The record of each lane into `out` (as many as it holds): what
+    /// [`PixelRecord::new`] makes of [`Traced4::colours`] (or the mean colour of
+    /// several samples, `mean`), the lane's first hit and `rays`, converted four
+    /// lanes at a time.
+    #[inline(always)]
+    fn write(&self, mean: Option<[Vec3; WIDTH]>, rays: &[Rays; WIDTH], out: &mut [PixelRecord]) {
+        let zero = T::Lanes::splat(T::of(0.0));
+        let one = T::Lanes::splat(T::of(1.0));
+        // Real::clamp01 lane by lane (a NaN stays), then float32.
+        let clamp = |c: T::Lanes| c.lt(zero).select(zero, c.gt(one).select(one, c));
+        let f32s = |l: T::Lanes| {
+            let a = l.to_array();
+            each(|i| a[i].to_f64() as f32)
+        };
+        let colour = match mean {
+            Some(m) => [0, 1, 2].map(|c| each(|i| m[i][c] as f32)),
+            None => [self.colour.x, self.colour.y, self.colour.z].map(|c| f32s(clamp(c))),
+        };
+        let (depth, l_dot_n, highlight) =
+            (f32s(self.depth), f32s(self.l_dot_n), f32s(self.highlight));
+        let normal = [self.normal.x, self.normal.y, self.normal.z].map(f32s);
+        let count = |n: u64| u32::try_from(n).unwrap_or(u32::MAX);
+        for (i, pixel) in out.iter_mut().enumerate() {
             let on = |bits: u32| bits >> i & 1 == 1;
-            let shaded = |x: T| if on(self.shaded) { x.to_f64() } else { 0.0 };
-            on(self.hit).then(|| FirstHit {
-                depth: depth[i].to_f64(),
-                normal: normal[i].to_f64(),
-                lit: on(self.lit),
-                object: self.object[i],
-                diffuse: shaded(l_dot_n[i]),
-                specular: shaded(highlight[i]),
-            })
-        })
+            let shaded = |x: f32| if on(self.shaded) { x } else { 0.0 };
+            let hit = on(self.hit);
+            *pixel = PixelRecord {
+                colour: [colour[0][i], colour[1][i], colour[2][i]],
+                depth: if hit {
+                    depth[i].min(f32::MAX)
+                } else {
+                    f32::INFINITY
+                },
+                normal: if hit {
+                    [normal[0][i], normal[1][i], normal[2][i]]
+                } else {
+                    [0.0; 3]
+                },
+                shadow: if !hit {
+                    -1.0
+                } else if on(self.lit) {
+                    1.0
+                } else {
+                    0.0
+                },
+                object: if hit {
+                    count(self.object[i] as u64)
+                } else {
+                    NO_OBJECT
+                },
+                diffuse: if hit { shaded(l_dot_n[i]) } else { 0.0 },
+                specular: if hit { shaded(highlight[i]) } else { 0.0 },
+                bounces: self.reflection_rays[i],
+                rays: count(rays[i].total()),
+            };
+        }
     }
 
     /// Each lane's rays.
+    #[inline(always)]
     fn rays(&self) -> [Rays; WIDTH] {
-        std::array::from_fn(|i| Rays {
+        each(|i| Rays {
             primary: 1,
             shadow: u64::from(self.shadow_rays[i]),
             reflection: u64::from(self.reflection_rays[i]),
@@ -323,8 +375,8 @@ impl<T: Real> PacketSearch for Nearest<'_, T> {
 
     #[inline(always)]
     fn test(&mut self, index: usize) {
-        let tracer = self.tracer;
-        tracer.with_shape(index, |shape| self.consider(index, shape));
+        let shape = self.tracer.shape(index);
+        self.consider(index, &shape);
     }
 
     #[inline(always)]
@@ -378,8 +430,8 @@ impl<T: Real> PacketSearch for Blocked<'_, T> {
 
     #[inline(always)]
     fn test(&mut self, index: usize) {
-        let tracer = self.tracer;
-        tracer.with_shape(index, |shape| self.consider(shape));
+        let shape = self.tracer.shape(index);
+        self.consider(&shape);
     }
 
     #[inline(always)]
@@ -416,6 +468,7 @@ impl<T: Real> Tracer<T> {
     /// The records of pixels `col`, `col + 1`, … of row `row`, one per element of
     /// `out` (at most [`WIDTH`]), traced as one packet: what [`Tracer::pixel`] gives
     /// for each of them, and the rays they took.
+    #[inline(always)]
     pub fn pixel_packet(&self, row: u32, col: u32, out: &mut [PixelRecord]) -> Rays {
         let n = out.len();
         assert!((1..=WIDTH).contains(&n), "a packet has 1 to {WIDTH} pixels");
@@ -427,7 +480,7 @@ impl<T: Real> Tracer<T> {
         debug_assert!(self.packets, "a tracer made without packets");
         let lanes = ALL >> (WIDTH - n);
         // Lanes past the image's right edge repeat its last pixel, and are dropped.
-        let cols: [f64; WIDTH] = std::array::from_fn(|i| f64::from(col + i.min(n - 1) as u32));
+        let cols: [f64; WIDTH] = each(|i| f64::from(col + i.min(n - 1) as u32));
         let ray = self.rays_through([f64::from(row); WIDTH], cols);
         let mut total = Rays::default();
         if !self.stages.intersection {
@@ -440,28 +493,26 @@ impl<T: Real> Tracer<T> {
         }
         let candidates = self.masks.mask(row, col);
         let centre = self.trace_packet(ray, lanes, candidates);
-        let mut colour = centre.colours();
         let mut rays = centre.rays();
+        let mut mean = None;
         if self.spp > 1 {
             // Several samples: the mean colour; the buffers keep the centre ray's.
             let mut sum = [Vec3::ZERO; WIDTH];
             for sample in 0..self.spp {
                 let at: [(f64, f64); WIDTH] =
-                    std::array::from_fn(|i| stratified(row, cols[i] as u32, sample, self.spp));
-                let ray = self.rays_through(at.map(|a| a.0), at.map(|a| a.1));
+                    each(|i| stratified(row, cols[i] as u32, sample, self.spp));
+                let ray = self.rays_through(each(|i| at[i].0), each(|i| at[i].1));
                 let traced = self.trace_packet(ray, lanes, candidates);
                 for (i, (c, r)) in traced.colours().into_iter().zip(traced.rays()).enumerate() {
                     sum[i] += c;
                     rays[i] += r;
                 }
             }
-            colour = sum.map(|s| s / f64::from(self.spp));
+            mean = Some(each(|i| sum[i] / f64::from(self.spp)));
         }
-        let first = centre.firsts();
-        for (i, pixel) in out.iter_mut().enumerate() {
-            let bounces = u64::from(centre.reflection_rays[i]);
-            *pixel = PixelRecord::new(colour[i], first[i], bounces, rays[i].total());
-            total += rays[i];
+        centre.write(mean, &rays, out);
+        for r in &rays[..n] {
+            total += *r;
         }
         total
     }
@@ -481,7 +532,7 @@ impl<T: Real> Tracer<T> {
                 return T::Lanes::splat(from);
             }
             T::Lanes::splat(from)
-                + T::Lanes::from_array(at.map(T::of)) * T::Lanes::splat(to - from)
+                + T::Lanes::from_array(each(|i| T::of(at[i]))) * T::Lanes::splat(to - from)
                     / T::Lanes::splat(T::of(f64::from(n - 1)))
         };
         let x = grid(s.left, s.right, cols, camera.width);
@@ -497,6 +548,7 @@ impl<T: Real> Tracer<T> {
     // ANCHOR: trace_packet
     /// [`Tracer::trace`] for the four rays of `primary`, of which the lanes `lanes`
     /// count.
+    #[inline(always)]
     fn trace_packet(&self, mut ray: Packet<T>, lanes: u32, candidates: u64) -> Traced4<T> {
         let segments = if self.stages.reflection {
             self.max_depth
@@ -556,14 +608,16 @@ impl<T: Real> Tracer<T> {
 
             // Blinn-Phong, seen from the camera (or the ray's origin), where lit.
             let shading = lit != 0 && self.stages.blinn_phong;
-            let terms = shading.then(|| {
+            let terms = if shading {
                 let viewer = match self.viewer {
                     Viewer::Camera => V3::splat(T::Vec3::of(self.camera.position)),
                     Viewer::RayOrigin => ray.origin,
                 };
                 let to_viewer = (viewer - point).normalize();
-                self.terms_packet(object, lit, normal, to_light, to_viewer)
-            });
+                Some(self.terms_packet(object, lit, normal, to_light, to_viewer))
+            } else {
+                None
+            };
             if segment == 0 {
                 traced.hit = alive;
                 traced.lit = lit;
@@ -678,13 +732,13 @@ impl<T: Real> Tracer<T> {
     }
     // ANCHOR_END: nearest_packet
 
-    /// `f` of the geometry of object `index`: read where it is kept in lanes (a
-    /// short list), made on the spot for the many objects of a BVH.
+    /// The geometry of object `index`: read where it is kept in lanes (a short
+    /// list), made on the spot for the many objects of a BVH.
     #[inline(always)]
-    fn with_shape<R>(&self, index: usize, f: impl FnOnce(&Shape4<T>) -> R) -> R {
+    fn shape(&self, index: usize) -> Cow<'_, Shape4<T>> {
         match self.packed.get(index) {
-            Some(p) => f(&p.shape),
-            None => f(&Shape4::new(&self.objects[index])),
+            Some(p) => Cow::Borrowed(&p.shape),
+            None => Cow::Owned(Shape4::new(&self.objects[index])),
         }
     }
 

@@ -174,7 +174,7 @@ macro_rules! real {
 }
 
 real!(f32, glam::Vec3, wide::f32x4, "f32");
-real!(f64, glam::DVec3, wide::f64x4, "f64");
+real!(f64, glam::DVec3, crate::lanes::F64x4, "f64");
 
 /// Which [`Real`] a render computes in (`--precision`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]

@@ -48,6 +48,10 @@ pub struct Settings {
     /// Trace four neighbouring pixels at once in SIMD lanes (`--packets`; never
     /// changes a pixel; default on).
     pub packets: bool,
+    /// Where the processor has AVX, run the packet tracer compiled for it: four
+    /// float64 lanes to a register instead of two (`--avx`; never changes a
+    /// pixel; default on).
+    pub avx: bool,
 }
 
 impl From<Stages> for Settings {
@@ -62,6 +66,7 @@ impl From<Stages> for Settings {
             spp: 1,
             early_stop: true,
             packets: true,
+            avx: true,
         }
     }
 }
@@ -80,6 +85,7 @@ impl Settings {
             spp: 1,
             early_stop: false,
             packets: true,
+            avx: true,
         }
     }
 }
@@ -118,6 +124,9 @@ pub struct Tracer<T: Real = f64> {
     /// The objects as the packet tracer reads them; empty without packets or with
     /// a BVH.
     pub packed: Vec<Packed<T>>,
+    /// Run the packet tracer's AVX build ([`Settings::avx`], and the processor
+    /// has AVX).
+    pub avx: bool,
 }
 
 /// Half an 8-bit step: a path whose remaining segments cannot add this much to
@@ -216,7 +225,59 @@ impl<T: Real> Tracer<T> {
             reach,
             packets,
             packed,
+            avx: packets && settings.avx && has_avx(),
         }
+    }
+
+    // ANCHOR: packet_row
+    /// The records of row `row`, four pixels at a time ([`Tracer::pixel_packet`]),
+    /// into `line`, and the rays they took.
+    ///
+    /// The packet tracer is compiled twice: for any x86-64 processor (SSE2: two
+    /// float64 lanes to a register), and for one with AVX (four). Which one runs
+    /// is decided here, from what the processor says it has. Both compute every
+    /// lane with the same IEEE operations in the same order, so they give the same
+    /// bits; only the number of instructions differs.
+    pub fn packet_row(&self, row: u32, line: &mut [PixelRecord]) -> Rays {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx {
+            // SAFETY: `avx` is true only where the processor has AVX (`has_avx`).
+            #[allow(unsafe_code)]
+            return unsafe { self.packet_row_avx(row, line) };
+        }
+        self.packet_row_baseline(row, line)
+    }
+    // ANCHOR_END: packet_row
+
+    /// [`Tracer::packet_row_in_lanes`] compiled for any processor of the target.
+    /// (A function of its own, so that `packet_row`'s frame holds only one of the
+    /// two builds' variables: in a debug build, where they are not packed, each
+    /// build's frame is about a megabyte.)
+    #[inline(never)]
+    fn packet_row_baseline(&self, row: u32, line: &mut [PixelRecord]) -> Rays {
+        self.packet_row_in_lanes(row, line)
+    }
+
+    /// [`Tracer::packet_row_in_lanes`] compiled for AVX: everything it calls is
+    /// inlined into it, and so compiled for AVX too.
+    ///
+    /// # Safety
+    /// The processor must have AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[allow(unsafe_code)]
+    unsafe fn packet_row_avx(&self, row: u32, line: &mut [PixelRecord]) -> Rays {
+        self.packet_row_in_lanes(row, line)
+    }
+
+    /// The loop of [`Tracer::packet_row`], for whichever build calls it.
+    #[inline(always)]
+    fn packet_row_in_lanes(&self, row: u32, line: &mut [PixelRecord]) -> Rays {
+        let mut rays = Rays::default();
+        for (k, pixels) in line.chunks_mut(WIDTH).enumerate() {
+            rays += self.pixel_packet(row, (k * WIDTH) as u32, pixels);
+        }
+        rays
     }
 
     /// The nearest object along `ray` among `candidates` (bit `i`: object `i`):
@@ -487,6 +548,18 @@ pub fn splitmix64(x: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// Does this processor have AVX? (Asked once; false off x86-64.)
+pub fn has_avx() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// The colour of the `rays` stage: each component of a unit `direction` mapped
 /// from [−1, 1] to [0, 1] (before clipping).
 pub fn direction_colour(direction: Vec3) -> Vec3 {
@@ -540,9 +613,7 @@ fn render_in<T: Real>(
                 return rays; // Ctrl-C: the rest is skipped, and the frame thrown away
             }
             if tracer.packets {
-                for (k, pixels) in line.chunks_mut(WIDTH).enumerate() {
-                    rays += tracer.pixel_packet(row as u32, (k * WIDTH) as u32, pixels);
-                }
+                rays = tracer.packet_row(row as u32, line);
             } else {
                 for (col, pixel) in line.iter_mut().enumerate() {
                     let (record, taken) = tracer.pixel(row as u32, col as u32);

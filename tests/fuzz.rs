@@ -153,9 +153,10 @@ fn any_settings() -> impl Strategy<Value = Settings> {
         prop::sample::select(vec![1u32, 4, 9]),
         any::<bool>(),
         any::<bool>(),
+        any::<bool>(),
     )
         .prop_map(
-            |(last, without, f32, method, offset, viewer, accel, spp, early_stop, packets)| {
+            |(last, without, f32, method, offset, viewer, accel, spp, early_stop, packets, avx)| {
                 // `--stage last --without ...`, or all up to `last` if that set is refused.
                 let stages = Stages::select(last, &without).unwrap_or(Stages::up_to(last));
                 Settings {
@@ -167,6 +168,7 @@ fn any_settings() -> impl Strategy<Value = Settings> {
                     spp,
                     early_stop,
                     packets,
+                    avx,
                     ..Settings::from(stages)
                 }
             },

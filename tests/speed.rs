@@ -201,27 +201,35 @@ fn packets_change_no_bit_of_any_record_of_any_scene() {
         // Odd sizes, so that the last packet of a row is a partial one.
         (scene.width, scene.height) = (61, 37);
         for (what, settings) in packet_settings() {
-            let one = |packets| {
+            let one = |packets, avx| {
                 render(
                     &scene,
                     &Settings {
                         packets,
+                        avx,
                         ..settings
                     },
                     &|_| {},
                 )
             };
-            let (scalar, packets) = (one(false), one(true));
-            assert_eq!(scalar.rays, packets.rays, "{name}, {what}: ray counts");
-            let (a, b) = (bits(&scalar), bits(&packets));
-            if let Some(i) = (0..a.len()).find(|&i| a[i] != b[i]) {
-                panic!(
-                    "{name}, {what}: pixel ({}, {}) differs: {:?} against the scalar {:?}",
-                    i / 61,
-                    i % 61,
-                    packets.pixels[i],
-                    scalar.pixels[i]
+            let scalar = one(false, false);
+            // The packet tracer's plain x86-64 (SSE2) build, and its AVX build where
+            // the processor has AVX (elsewhere the plain one again).
+            for (build, packets) in [("sse2", one(true, false)), ("avx", one(true, true))] {
+                assert_eq!(
+                    scalar.rays, packets.rays,
+                    "{name}, {what}, {build}: ray counts"
                 );
+                let (a, b) = (bits(&scalar), bits(&packets));
+                if let Some(i) = (0..a.len()).find(|&i| a[i] != b[i]) {
+                    panic!(
+                        "{name}, {what}, {build}: pixel ({}, {}) differs: {:?} against the scalar {:?}",
+                        i / 61,
+                        i % 61,
+                        packets.pixels[i],
+                        scalar.pixels[i]
+                    );
+                }
             }
         }
     }
