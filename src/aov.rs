@@ -157,35 +157,66 @@ impl PixelRecord {
     /// The record of a pixel that ended with `colour`, whose first hit (if any)
     /// was `first`, whose path bounced `bounces` times and which traced `rays`.
     pub fn new(colour: Vec3, first: Option<FirstHit>, bounces: u64, rays: u64) -> PixelRecord {
-        let count = |n: u64| u32::try_from(n).unwrap_or(u32::MAX);
-        let mut record = PixelRecord {
-            colour: colour.as_vec3().to_array(),
+        let mut record = PixelRecord::missed(colour.as_vec3().to_array(), bounces, rays);
+        if let Some(hit) = first {
+            record.set_hit(
+                hit.depth as f32,
+                hit.normal.as_vec3().to_array(),
+                hit.lit,
+                hit.object,
+                hit.diffuse as f32,
+                hit.specular as f32,
+            );
+        }
+        record
+    }
+
+    /// The record of a pixel whose primary ray hit nothing: [`PixelRecord::new`]
+    /// with no first hit, the colour already in float32.
+    pub fn missed(colour: [f32; 3], bounces: u64, rays: u64) -> PixelRecord {
+        PixelRecord {
+            colour,
             depth: f32::INFINITY,
             normal: [0.0; 3],
             shadow: -1.0,
             object: NO_OBJECT,
             diffuse: 0.0,
             specular: 0.0,
-            bounces: count(bounces),
-            rays: count(rays),
-        };
-        if let Some(hit) = first {
-            // A hit beyond float32's range (a plane met almost edge-on) is stored
-            // as the largest float32: still a hit, not the +∞ of a miss.
-            record.depth = (hit.depth as f32).min(f32::MAX);
-            record.normal = hit.normal.as_vec3().to_array();
-            record.shadow = if hit.lit { 1.0 } else { 0.0 };
-            record.object = count(hit.object as u64);
-            record.diffuse = hit.diffuse as f32;
-            record.specular = hit.specular as f32;
+            bounces: saturate(bounces),
+            rays: saturate(rays),
         }
-        record
+    }
+
+    /// Record the first hit, its numbers (those of [`FirstHit`]) already in
+    /// float32.
+    pub fn set_hit(
+        &mut self,
+        depth: f32,
+        normal: [f32; 3],
+        lit: bool,
+        object: usize,
+        diffuse: f32,
+        specular: f32,
+    ) {
+        // A hit beyond float32's range (a plane met almost edge-on) is stored as
+        // the largest float32: still a hit, not the +∞ of a miss.
+        self.depth = depth.min(f32::MAX);
+        self.normal = normal;
+        self.shadow = if lit { 1.0 } else { 0.0 };
+        self.object = saturate(object as u64);
+        self.diffuse = diffuse;
+        self.specular = specular;
     }
 
     /// Did the primary ray hit anything?
     pub fn is_hit(&self) -> bool {
         self.depth.is_finite()
     }
+}
+
+/// `n` as a record's `u32`, the largest one if it is larger.
+fn saturate(n: u64) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
 }
 
 /// A rendered image: a record per pixel, row by row from the top.

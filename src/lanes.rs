@@ -190,7 +190,9 @@ lanes!(f32, wide::f32x4, u32);
 pub struct F64x4(pub [f64; WIDTH]);
 
 impl F64x4 {
-    /// `f` of each lane.
+    /// `f` of each lane. (Here and in `zip` the lanes are written out rather than
+    /// made by [`each`]: through `each` the render ran 8 % more instructions, the
+    /// compiler vectorising less of it.)
     #[inline(always)]
     fn map(self, f: impl Fn(f64) -> f64) -> F64x4 {
         F64x4([f(self.0[0]), f(self.0[1]), f(self.0[2]), f(self.0[3])])
@@ -359,7 +361,6 @@ impl Lanes<f64> for F64x4 {
         (self & yes) | (!self & no)
     }
     #[inline(always)]
-    #[allow(unsafe_code)]
     fn bits(self) -> u32 {
         let sign = |i: usize| (self.0[i].to_bits() >> 63) as u32;
         sign(0) | sign(1) << 1 | sign(2) << 2 | sign(3) << 3

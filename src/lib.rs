@@ -16,8 +16,8 @@
 //!
 //! The modules below are listed in the order the book introduces them, so this
 //! file reads as its table of contents.
-// Two places only, each with its reason: SSE2's sign-bit gather (lanes.rs) and
-// the call of the AVX build of the packet loop once AVX is found (render.rs).
+// One place only, with its reason: the call of the packet loop's AVX build once
+// the processor is found to have AVX (`Tracer::packet_row`, render.rs).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 

@@ -42,7 +42,7 @@
 use std::borrow::Cow;
 
 use crate::accel::{EVERY, TILE};
-use crate::aov::{PixelRecord, NO_OBJECT};
+use crate::aov::PixelRecord;
 use crate::bvh::PacketSearch;
 use crate::lanes::{convert, each, powi, F64s, Lanes, ALL, V3, WIDTH};
 use crate::real::{Real, Vector};
@@ -301,40 +301,22 @@ impl<T: Real> Traced4<T> {
         let (depth, l_dot_n, highlight) =
             (f32s(self.depth), f32s(self.l_dot_n), f32s(self.highlight));
         let normal = [self.normal.x, self.normal.y, self.normal.z].map(f32s);
-        let count = |n: u64| u32::try_from(n).unwrap_or(u32::MAX);
         for (i, pixel) in out.iter_mut().enumerate() {
             let on = |bits: u32| bits >> i & 1 == 1;
-            let shaded = |x: f32| if on(self.shaded) { x } else { 0.0 };
-            let hit = on(self.hit);
-            *pixel = PixelRecord {
-                colour: [colour[0][i], colour[1][i], colour[2][i]],
-                depth: if hit {
-                    depth[i].min(f32::MAX)
-                } else {
-                    f32::INFINITY
-                },
-                normal: if hit {
-                    [normal[0][i], normal[1][i], normal[2][i]]
-                } else {
-                    [0.0; 3]
-                },
-                shadow: if !hit {
-                    -1.0
-                } else if on(self.lit) {
-                    1.0
-                } else {
-                    0.0
-                },
-                object: if hit {
-                    count(self.object[i] as u64)
-                } else {
-                    NO_OBJECT
-                },
-                diffuse: if hit { shaded(l_dot_n[i]) } else { 0.0 },
-                specular: if hit { shaded(highlight[i]) } else { 0.0 },
-                bounces: self.reflection_rays[i],
-                rays: count(rays[i].total()),
-            };
+            let colour = [colour[0][i], colour[1][i], colour[2][i]];
+            let bounces = u64::from(self.reflection_rays[i]);
+            *pixel = PixelRecord::missed(colour, bounces, rays[i].total());
+            if on(self.hit) {
+                let shaded = |x: [f32; WIDTH]| if on(self.shaded) { x[i] } else { 0.0 };
+                pixel.set_hit(
+                    depth[i],
+                    [normal[0][i], normal[1][i], normal[2][i]],
+                    on(self.lit),
+                    self.object[i],
+                    shaded(l_dot_n),
+                    shaded(highlight),
+                );
+            }
         }
     }
 
