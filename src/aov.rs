@@ -18,7 +18,7 @@
 
 use crate::camera::Camera;
 use crate::real::{Precision, Vector};
-use crate::render::Rays;
+use crate::render::{Packets, Rays};
 use crate::stages::Stages;
 use crate::Vec3;
 
@@ -237,6 +237,9 @@ pub struct Frame {
     pub precision: Precision,
     /// The rays traced for the whole frame.
     pub rays: Rays,
+    /// How the pixels were traced: one ray at a time, or which build of the
+    /// packet loop ran (`raystep bench` reports it).
+    pub packets: Packets,
     /// `width × height` records, row-major, top row first.
     pub pixels: Vec<PixelRecord>,
 }
@@ -253,6 +256,7 @@ impl Frame {
             camera,
             precision,
             rays: Rays::default(),
+            packets: Packets::Off,
             pixels: vec![blank; camera.width as usize * camera.height as usize],
         }
     }

@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use crate::aov::Frame;
 use crate::error::Error;
-use crate::render::{has_avx, render_into, Rays, Settings};
+use crate::render::{render_into, Packets, Rays, Settings};
 use crate::scene::Scene;
 use crate::yardstick::Yardstick;
 
@@ -55,7 +55,7 @@ pub struct Report {
     pub peak_memory_bytes: Option<u64>,
     /// The build of the packet tracer that ran: `"avx"` (four float64 lanes to
     /// a register), `"baseline"` (two, as on any x86-64 processor: SSE2), or
-    /// `"off"` with `--packets off`.
+    /// `"off"` when one ray at a time was traced.
     pub packets: &'static str,
 }
 
@@ -92,10 +92,12 @@ pub fn bench(
     let mut frame = Frame::blank(scene.camera(), settings.precision);
     let mut one_frame = frame.clone();
     let mut rays = Rays::default();
+    let mut packets = Packets::Off;
     let mut image = Vec::new();
     let mut jobs: Vec<Job> = vec![Box::new(|| {
         many.install(|| render_into(scene, settings, &mut frame, &|_| {}));
         rays = frame.rays;
+        packets = frame.packets;
     })];
     if options.threads > 1 {
         jobs.push(Box::new(|| {
@@ -143,11 +145,7 @@ pub fn bench(
         yardstick_median_s,
         yardstick_ratio: yardstick_median_s.map(|t| t / median_s),
         peak_memory_bytes: peak_memory_bytes(),
-        packets: match (settings.packets, settings.avx && has_avx()) {
-            (false, _) => "off",
-            (true, true) => "avx",
-            (true, false) => "baseline",
-        },
+        packets: packets.name(),
     })
 }
 

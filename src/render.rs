@@ -129,6 +129,29 @@ pub struct Tracer<T: Real = f64> {
     pub avx: bool,
 }
 
+/// How a frame's pixels were traced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Packets {
+    /// One ray at a time (`--packets off`, or too many objects for the masks).
+    Off,
+    /// Four at a time, the build for any processor (two float64 lanes to a
+    /// register on x86-64: SSE2).
+    Baseline,
+    /// Four at a time, the AVX build (four float64 lanes to a register).
+    Avx,
+}
+
+impl Packets {
+    /// `"off"`, `"baseline"` or `"avx"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Packets::Off => "off",
+            Packets::Baseline => "baseline",
+            Packets::Avx => "avx",
+        }
+    }
+}
+
 /// Half an 8-bit step: a path whose remaining segments cannot add this much to
 /// any channel is ended early (`--early-stop`).
 pub const HALF_STEP: f64 = 0.5 / 255.0;
@@ -644,5 +667,10 @@ fn render_in<T: Real>(
     frame.camera = tracer.camera;
     frame.precision = settings.precision;
     frame.rays = rays;
+    frame.packets = match (tracer.packets, tracer.avx) {
+        (false, _) => Packets::Off,
+        (true, false) => Packets::Baseline,
+        (true, true) => Packets::Avx,
+    };
 }
 // ANCHOR_END: render
