@@ -33,6 +33,13 @@
 //! That is why the functions here are `#[inline(always)]`: only what is inlined
 //! into the AVX build's entry is compiled for AVX. The two give the same bits.
 //!
+//! Even four at a time, a packet spends most of its time waiting on a square root
+//! or a division whose result the next step needs. So two things are computed
+//! earlier than the book's order would put them, to overlap with other waiting:
+//! [`Tracer::packet_row`] makes the primary rays of [`BATCH`] packets before it
+//! traces any of them, and `trace_packet` starts the light's distance and the
+//! direction to the viewer as soon as the hit point is known.
+//!
 //! `--packets on` (the default) traces scenes of up to [`MAX_OBJECTS`] objects by
 //! the plain loop (with the tile masks), and larger ones through the BVH, which a
 //! packet walks together ([`Bvh::search_packet`](crate::bvh::Bvh::search_packet)).
@@ -44,7 +51,7 @@ use std::borrow::Cow;
 use crate::accel::{EVERY, TILE};
 use crate::aov::PixelRecord;
 use crate::bvh::PacketSearch;
-use crate::lanes::{convert, each, powi, F64s, Lanes, ALL, V3, WIDTH};
+use crate::lanes::{components, convert, each, powi, F64s, Lanes, ALL, V3, WIDTH};
 use crate::real::{Real, Vector};
 use crate::render::{direction_colour, stratified, Rays, Tracer, HALF_STEP};
 use crate::scene::{Light, Object, Shape};
@@ -58,6 +65,10 @@ const _: () = assert!(TILE.0 as usize % WIDTH == 0);
 
 /// The most objects the packet tracer takes (one bit each in a search mask).
 pub const MAX_OBJECTS: usize = 64;
+
+/// How many packets' primary rays [`Tracer::packet_row`] makes before it traces
+/// them.
+pub const BATCH: usize = 16;
 
 /// An object as the packet tracer reads it: every number it needs, in precision
 /// `T` and in every lane, worked out once per render as the scalar tracer works
@@ -305,10 +316,10 @@ impl<T: Real> Traced4<T> {
             let on = |bits: u32| bits >> i & 1 == 1;
             let colour = [colour[0][i], colour[1][i], colour[2][i]];
             let bounces = u64::from(self.reflection_rays[i]);
-            *pixel = PixelRecord::missed(colour, bounces, rays[i].total());
+            let mut record = PixelRecord::missed(colour, bounces, rays[i].total());
             if on(self.hit) {
                 let shaded = |x: [f32; WIDTH]| if on(self.shaded) { x[i] } else { 0.0 };
-                pixel.set_hit(
+                record.set_hit(
                     depth[i],
                     [normal[0][i], normal[1][i], normal[2][i]],
                     on(self.lit),
@@ -317,6 +328,7 @@ impl<T: Real> Traced4<T> {
                     shaded(highlight),
                 );
             }
+            *pixel = record;
         }
     }
 
@@ -376,16 +388,24 @@ impl<T: Real> Nearest<'_, T> {
             return;
         }
         let mut nearer = (hit & (!self.found | t.lt(self.t))).bits();
+        // A tie (two objects at one distance, which is rare) goes to the lower index.
         let tie = (hit & self.found & !t.ne(self.t)).bits();
-        for i in lanes_of(tie) {
-            if index < self.which[i] {
-                nearer |= 1 << i;
+        if tie != 0 {
+            for i in lanes_of(tie) {
+                if index < self.which[i] {
+                    nearer |= 1 << i;
+                }
             }
+        }
+        if nearer == 0 {
+            return;
         }
         let m = T::Lanes::mask(nearer);
         self.t = m.select(t, self.t);
-        for i in lanes_of(nearer) {
-            self.which[i] = index;
+        for (i, which) in self.which.iter_mut().enumerate() {
+            if nearer >> i & 1 == 1 {
+                *which = index;
+            }
         }
         self.found = self.found | m;
     }
@@ -434,7 +454,12 @@ impl<T: Real> Blocked<'_, T> {
 /// The lanes `bits` as indices.
 #[inline(always)]
 fn lanes_of(bits: u32) -> impl Iterator<Item = usize> {
-    (0..WIDTH).filter(move |i| bits >> i & 1 == 1)
+    let mut left = bits & ALL;
+    std::iter::from_fn(move || {
+        let lane = left.trailing_zeros() as usize;
+        left &= left.wrapping_sub(1);
+        (lane < WIDTH).then_some(lane)
+    })
 }
 
 /// Add one to `counts[i]` for each lane `i` of `bits`.
@@ -448,10 +473,17 @@ fn count(counts: &mut [u32; WIDTH], bits: u32) {
 impl<T: Real> Tracer<T> {
     // ANCHOR: packet
     /// The records of pixels `col`, `col + 1`, … of row `row`, one per element of
-    /// `out` (at most [`WIDTH`]), traced as one packet: what [`Tracer::pixel`] gives
-    /// for each of them, and the rays they took.
+    /// `out` (at most [`WIDTH`]), traced as one packet from their primary rays `ray`
+    /// ([`Tracer::pixel_rays`]): what [`Tracer::pixel`] gives for each of them, and
+    /// the rays they took.
     #[inline(always)]
-    pub fn pixel_packet(&self, row: u32, col: u32, out: &mut [PixelRecord]) -> Rays {
+    pub fn pixel_packet(
+        &self,
+        row: u32,
+        col: u32,
+        ray: &Packet<T>,
+        out: &mut [PixelRecord],
+    ) -> Rays {
         let n = out.len();
         assert!((1..=WIDTH).contains(&n), "a packet has 1 to {WIDTH} pixels");
         // The four pixels share the tile mask of the first, and the objects in lanes.
@@ -461,9 +493,7 @@ impl<T: Real> Tracer<T> {
         );
         debug_assert!(self.packets, "a tracer made without packets");
         let lanes = ALL >> (WIDTH - n);
-        // Lanes past the image's right edge repeat its last pixel, and are dropped.
-        let cols: [f64; WIDTH] = each(|i| f64::from(col + i.min(n - 1) as u32));
-        let ray = self.rays_through([f64::from(row); WIDTH], cols);
+        let ray = *ray;
         let mut total = Rays::default();
         if !self.stages.intersection {
             for (pixel, d) in out.iter_mut().zip(ray.direction.to_vectors()) {
@@ -482,7 +512,7 @@ impl<T: Real> Tracer<T> {
             let mut sum = [Vec3::ZERO; WIDTH];
             for sample in 0..self.spp {
                 let at: [(f64, f64); WIDTH] =
-                    each(|i| stratified(row, cols[i] as u32, sample, self.spp));
+                    each(|i| stratified(row, self.column(col, i), sample, self.spp));
                 let ray = self.rays_through(each(|i| at[i].0), each(|i| at[i].1));
                 let traced = self.trace_packet(ray, lanes, candidates);
                 for (i, (c, r)) in traced.colours().into_iter().zip(traced.rays()).enumerate() {
@@ -499,6 +529,24 @@ impl<T: Real> Tracer<T> {
         total
     }
     // ANCHOR_END: packet
+
+    /// The primary rays of pixels `col` to `col + 3` of row `row`: the packet
+    /// [`Tracer::pixel_packet`] traces from there. Lanes past the image's right
+    /// edge repeat its last pixel (their records are dropped).
+    #[inline(always)]
+    pub fn pixel_rays(&self, row: u32, col: u32) -> Packet<T> {
+        // The screen points, as the camera gives them: x read from its table.
+        let x = T::Lanes::from_array(each(|i| self.columns[self.column(col, i) as usize]));
+        let [_, y, _] = components::<T>(self.camera.screen_point::<T>(row, 0));
+        self.rays_to(x, T::Lanes::splat(y))
+    }
+
+    /// The column of lane `i` of the packet at `col`: `col + i`, or the image's
+    /// last column past its right edge.
+    #[inline(always)]
+    fn column(&self, col: u32, i: usize) -> u32 {
+        (col + i as u32).min(self.camera.width - 1)
+    }
 
     /// The rays from the eye through the screen at fractional (`rows[i]`,
     /// `cols[i]`), as [`Camera::ray_through`](crate::camera::Camera::ray_through)
@@ -519,7 +567,14 @@ impl<T: Real> Tracer<T> {
         };
         let x = grid(s.left, s.right, cols, camera.width);
         let y = grid(s.top, s.bottom, rows, camera.height);
-        let origin = V3::splat(T::Vec3::of(camera.position));
+        self.rays_to(x, y)
+    }
+
+    /// The rays from the eye through the screen points (`x[i]`, `y[i]`, 0), as
+    /// [`Ray::towards`](crate::ray::Ray::towards) makes each.
+    #[inline(always)]
+    fn rays_to(&self, x: T::Lanes, y: T::Lanes) -> Packet<T> {
+        let origin = V3::splat(T::Vec3::of(self.camera.position));
         let target = V3::new(x, y, T::Lanes::splat(T::of(0.0)));
         Packet {
             origin,
@@ -571,14 +626,30 @@ impl<T: Real> Tracer<T> {
                 }
             };
             let point = ray.at(t);
+            // The light's distance and the direction to the viewer, made before
+            // they are needed (if they are): their square roots and divisions then
+            // overlap the normal's and the shadow test's.
+            let light_distance = if self.stages.shadow {
+                Some((light - point).length())
+            } else {
+                None
+            };
+            let viewer = match self.viewer {
+                Viewer::Camera => V3::splat(T::Vec3::of(self.camera.position)),
+                Viewer::RayOrigin => ray.origin,
+            };
+            let to_viewer = if self.stages.blinn_phong {
+                Some((viewer - point).normalize())
+            } else {
+                None
+            };
             let normal = self.normal_packet(object, alive, point, &ray);
             let shifted = self.step_off_packet(object, alive, point, normal);
             let to_light = (light - shifted).normalize();
 
             // Shadow: the lanes whose point does not see the light end, black.
-            let lit = if self.stages.shadow {
+            let lit = if let Some(light_distance) = light_distance {
                 count(&mut traced.shadow_rays, alive);
-                let light_distance = (light - point).length();
                 let shadow_ray = Packet {
                     origin: shifted,
                     direction: to_light,
@@ -589,16 +660,11 @@ impl<T: Real> Tracer<T> {
             };
 
             // Blinn-Phong, seen from the camera (or the ray's origin), where lit.
-            let shading = lit != 0 && self.stages.blinn_phong;
-            let terms = if shading {
-                let viewer = match self.viewer {
-                    Viewer::Camera => V3::splat(T::Vec3::of(self.camera.position)),
-                    Viewer::RayOrigin => ray.origin,
-                };
-                let to_viewer = (viewer - point).normalize();
-                Some(self.terms_packet(object, lit, normal, to_light, to_viewer))
-            } else {
-                None
+            let terms = match to_viewer {
+                Some(to_viewer) if lit != 0 => {
+                    Some(self.terms_packet(object, lit, normal, to_light, to_viewer))
+                }
+                _ => None,
             };
             if segment == 0 {
                 traced.hit = alive;
@@ -636,12 +702,8 @@ impl<T: Real> Tracer<T> {
             // Early stop: nothing the rest of the path adds can change the pixel.
             let left = (segments - segment - 1) as usize;
             if let Some(&reach) = self.reach.get(left) {
-                let w = weight.to_array();
-                for (i, w) in w.iter().enumerate() {
-                    if w.to_f64() * reach < HALF_STEP {
-                        alive &= !(1 << i);
-                    }
-                }
+                let most = convert::<T, f64>(weight) * F64s::splat(reach);
+                alive &= !most.lt(F64s::splat(HALF_STEP)).bits();
                 if alive == 0 {
                     break;
                 }

@@ -10,7 +10,7 @@ use crate::aov::{FirstHit, Frame, PixelRecord};
 use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::lanes::WIDTH;
-use crate::packet::Packed;
+use crate::packet::{Packed, BATCH};
 use crate::ray::Ray;
 use crate::real::{Precision, Real, Vector};
 use crate::scene::{consider, nearest_hit, Hit, Light, Object, Role, Scene};
@@ -127,6 +127,9 @@ pub struct Tracer<T: Real = f64> {
     /// Run the packet tracer's AVX build ([`Settings::avx`], and the processor
     /// has AVX).
     pub avx: bool,
+    /// The screen's `x` at each column, for the packet tracer's primary rays
+    /// (empty without packets).
+    pub columns: Vec<T>,
 }
 
 /// How a frame's pixels were traced.
@@ -238,7 +241,6 @@ impl<T: Real> Tracer<T> {
             method: settings.method,
             offset: settings.offset,
             viewer: settings.viewer,
-            camera,
             objects,
             light,
             max_depth: scene.max_depth,
@@ -249,6 +251,13 @@ impl<T: Real> Tracer<T> {
             packets,
             packed,
             avx: packets && settings.avx && has_avx(),
+            columns: match packets {
+                true => (0..camera.width)
+                    .map(|col| crate::lanes::components::<T>(camera.screen_point::<T>(0, col))[0])
+                    .collect(),
+                false => Vec::new(),
+            },
+            camera,
         }
     }
 
@@ -297,8 +306,19 @@ impl<T: Real> Tracer<T> {
     #[inline(always)]
     fn packet_row_in_lanes(&self, row: u32, line: &mut [PixelRecord]) -> Rays {
         let mut rays = Rays::default();
-        for (k, pixels) in line.chunks_mut(WIDTH).enumerate() {
-            rays += self.pixel_packet(row, (k * WIDTH) as u32, pixels);
+        // The primary rays of a few packets are made before any of them is traced.
+        // Each direction waits on a square root and a division; made one after the
+        // other they overlap, where made just before its packet each would hold up
+        // everything after it.
+        for (b, batch) in line.chunks_mut(WIDTH * BATCH).enumerate() {
+            let first = (b * WIDTH * BATCH) as u32;
+            let mut primary = [self.pixel_rays(row, first); BATCH];
+            for (k, packet) in primary.iter_mut().enumerate().skip(1) {
+                *packet = self.pixel_rays(row, first + (k * WIDTH) as u32);
+            }
+            for (k, pixels) in batch.chunks_mut(WIDTH).enumerate() {
+                rays += self.pixel_packet(row, first + (k * WIDTH) as u32, &primary[k], pixels);
+            }
         }
         rays
     }

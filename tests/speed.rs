@@ -445,19 +445,17 @@ fn the_pixel_loop_allocates_nothing() {
         (many, Settings::from(Stages::ALL)),
     ] {
         let tracer = Tracer::<f64>::new(&scene, &settings);
-        let mut line = vec![PixelRecord::new(Default::default(), None, 0, 0); 4];
+        let mut line = vec![PixelRecord::new(Default::default(), None, 0, 0); scene.width as usize];
         COUNTING.with(|c| c.set(true));
         let (mut sum, mut packed) = (0.0, 0.0);
         for row in 0..scene.height {
             for col in 0..scene.width {
                 sum += tracer.pixel(row, col).0.colour[0];
             }
-            // The packet loop, where the scene has one (no BVH).
+            // The packet loop, where the scene has one.
             if tracer.packets {
-                for col in (0..scene.width).step_by(4) {
-                    tracer.pixel_packet(row, col, &mut line);
-                    packed += line.iter().map(|p| p.colour[0]).sum::<f32>();
-                }
+                tracer.packet_row(row, &mut line);
+                packed += line.iter().map(|p| p.colour[0]).sum::<f32>();
             }
         }
         COUNTING.with(|c| c.set(false));
