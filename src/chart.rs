@@ -20,6 +20,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
+use plotters::coord::combinators::{BindKeyPoints, WithKeyPoints};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
@@ -391,8 +392,27 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     (lo / 1.6)..(hi * 1.6)
 }
 
-/// A chart whose axes are both logarithmic.
-type LogLog<'a, DB> = ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+/// The labelled values of a log axis over `range`: 1, 2, …, 9 times each power of
+/// ten where the axis spans less than two decades, else the powers of ten alone.
+/// (Plotters' own choice gives each power of ten twice, as the last multiple of
+/// one decade and the first of the next, and its label is drawn twice.)
+fn log_ticks(range: &std::ops::Range<f64>) -> Vec<f64> {
+    let (lo, hi) = (range.start, range.end);
+    let multiples: &[f64] = if (hi / lo).log10() < 2.0 {
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]
+    } else {
+        &[1.0]
+    };
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    (first..=last)
+        .flat_map(|k| multiples.iter().map(move |m| m * 10f64.powi(k)))
+        .filter(|v| (lo..=hi).contains(v))
+        .collect()
+}
+
+/// A chart whose axes are both logarithmic, labelled at [`log_ticks`].
+type LogLog<'a, DB> =
+    ChartContext<'a, DB, Cartesian2d<WithKeyPoints<LogCoord<f64>>, WithKeyPoints<LogCoord<f64>>>>;
 
 /// The axes of a chart on a white `root`: both logarithmic, over the ranges given,
 /// named, with `y_decimals` decimals on the y labels.
@@ -410,7 +430,10 @@ fn log_log<'a, DB: DrawingBackend>(
         .margin(20)
         .x_label_area_size(50)
         .y_label_area_size(70)
-        .build_cartesian_2d(xs.log_scale(), ys.log_scale())
+        .build_cartesian_2d(
+            xs.clone().log_scale().with_key_points(log_ticks(&xs)),
+            ys.clone().log_scale().with_key_points(log_ticks(&ys)),
+        )
         .map_err(e)?;
     chart
         .configure_mesh()
@@ -598,6 +621,29 @@ pub fn write_scale(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_log_axis_labels_each_value_once() {
+        // Under two decades: every multiple of each power of ten inside the range.
+        let ticks = log_ticks(&(6.0..300.0));
+        let want = [
+            6, 7, 8, 9, 10, 20, 30, 40, 50, 60, 70, 80, 90, 100, 200, 300,
+        ];
+        assert_eq!(ticks.len(), want.len(), "{ticks:?}");
+        for (t, w) in ticks.iter().zip(want) {
+            assert!((t - f64::from(w)).abs() < 1e-9 * t, "{ticks:?}");
+        }
+        let small = log_ticks(&(0.39..25.0));
+        assert_eq!(small.iter().filter(|&&t| (t - 1.0).abs() < 1e-9).count(), 1);
+        assert_eq!(
+            small.iter().filter(|&&t| (t - 10.0).abs() < 1e-9).count(),
+            1
+        );
+        assert!(small.windows(2).all(|w| w[0] < w[1]), "{small:?}");
+        // Two decades or more: the powers of ten alone.
+        let wide = log_ticks(&(0.6..1.6e6));
+        assert_eq!(wide, [1.0, 10.0, 100.0, 1e3, 1e4, 1e5, 1e6]);
+    }
 
     fn point(label: &str, ms: f64, rmse: f64) -> Point {
         Point {

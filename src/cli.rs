@@ -58,7 +58,7 @@ of the render before stay as they were).";
 /// The subcommands.
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Render every stage, rays to plane, each into DIR/<NN>-<stage>/ with its buffers.
+    /// Render every stage, rays to plane, each into DIR/NN-STAGE/ (01-rays, …, 06-plane) with its buffers.
     Stages(StagesArgs),
     /// Render one set of stages into DIR/: beauty, buffers as PNG, and buffers.exr.
     Render(RenderArgs),

@@ -72,7 +72,7 @@ pub const BATCH: usize = 16;
 
 /// An object as the packet tracer reads it: every number it needs, in precision
 /// `T` and in every lane, worked out once per render as the scalar tracer works
-/// it out at each hit. Lane `i` of a blend ([`Packed::blend`]) holds the numbers
+/// it out at each hit. Lane `i` of a blend (`Packed::blend`) holds the numbers
 /// of the object hit in lane `i`.
 #[derive(Clone, Copy, Debug)]
 pub struct Packed<T: Real> {
