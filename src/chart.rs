@@ -225,7 +225,7 @@ pub fn csv(points: &[Point]) -> String {
         let _ = writeln!(
             out,
             "{},{:.3},{:.4},{:.2},{},{}",
-            p.label,
+            csv_field(&p.label),
             p.median_s * 1e3,
             p.rmse,
             p.worst,
@@ -234,6 +234,16 @@ pub fn csv(points: &[Point]) -> String {
         );
     }
     out
+}
+
+/// `text` as one CSV field: quoted (and its quotes doubled) where it holds a
+/// comma, a quote or a line break, as RFC 4180 has it ("spp 4, f32" is a label).
+fn csv_field(text: &str) -> std::borrow::Cow<'_, str> {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\"")).into()
+    } else {
+        text.into()
+    }
 }
 
 /// One measurement of the scale sweep.
@@ -621,6 +631,15 @@ pub fn write_scale(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_label_with_a_comma_stays_one_csv_field() {
+        let text = csv(&[point("spp 4, f32", 10.0, 1.0), point("default", 5.0, 2.0)]);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[1], "\"spp 4, f32\",10.000,1.0000,1.00,false,false");
+        assert_eq!(lines[2], "default,5.000,2.0000,2.00,false,false");
+        assert_eq!(csv_field("a \"b\""), "\"a \"\"b\"\"\"");
+    }
 
     #[test]
     fn a_log_axis_labels_each_value_once() {
