@@ -481,7 +481,7 @@ impl<T: Real> Tracer<T> {
         &self,
         row: u32,
         col: u32,
-        ray: &Packet<T>,
+        ray: Packet<T>,
         out: &mut [PixelRecord],
     ) -> Rays {
         let n = out.len();
@@ -493,7 +493,6 @@ impl<T: Real> Tracer<T> {
         );
         debug_assert!(self.packets, "a tracer made without packets");
         let lanes = ALL >> (WIDTH - n);
-        let ray = *ray;
         let mut total = Rays::default();
         if !self.stages.intersection {
             for (pixel, d) in out.iter_mut().zip(ray.direction.to_vectors()) {
@@ -530,7 +529,7 @@ impl<T: Real> Tracer<T> {
     }
     // ANCHOR_END: packet
 
-    /// The primary rays of pixels `col` to `col + 3` of row `row`: the packet
+    /// The primary rays of pixels `col`, `col + 1`, … of row `row`: the packet
     /// [`Tracer::pixel_packet`] traces from there. Lanes past the image's right
     /// edge repeat its last pixel (their records are dropped).
     #[inline(always)]
@@ -634,11 +633,11 @@ impl<T: Real> Tracer<T> {
             } else {
                 None
             };
-            let viewer = match self.viewer {
-                Viewer::Camera => V3::splat(T::Vec3::of(self.camera.position)),
-                Viewer::RayOrigin => ray.origin,
-            };
             let to_viewer = if self.stages.blinn_phong {
+                let viewer = match self.viewer {
+                    Viewer::Camera => V3::splat(T::Vec3::of(self.camera.position)),
+                    Viewer::RayOrigin => ray.origin,
+                };
                 Some((viewer - point).normalize())
             } else {
                 None

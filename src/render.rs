@@ -317,7 +317,7 @@ impl<T: Real> Tracer<T> {
                 *packet = self.pixel_rays(row, first + (k * WIDTH) as u32);
             }
             for (k, pixels) in batch.chunks_mut(WIDTH).enumerate() {
-                rays += self.pixel_packet(row, first + (k * WIDTH) as u32, &primary[k], pixels);
+                rays += self.pixel_packet(row, first + (k * WIDTH) as u32, primary[k], pixels);
             }
         }
         rays
