@@ -10,7 +10,7 @@ use raystep::real::{Precision, Real, Vector};
 use raystep::render::{render, Settings};
 use raystep::shade::shadow::Offset;
 use raystep::sphere::{Method, Sphere};
-use raystep::stages::Stages;
+use raystep::stages::{Engine, Stages};
 use raystep::Vec3;
 
 fn main() {
@@ -75,15 +75,19 @@ fn figure_1(bencher: Bencher, config: usize) {
     bencher.bench(|| render(&scene, &settings, &|_| {}));
 }
 
-/// Figure 1 with the defaults, one ray at a time against four at once.
-#[divan::bench(args = ["one ray", "packets"], sample_count = 60)]
-fn packets(bencher: Bencher, how: &str) {
+/// Figure 1 with the defaults: the book's engine, one ray at a time, against the
+/// fast one, four at once.
+#[divan::bench(args = ["book", "fast"], sample_count = 60)]
+fn engines(bencher: Bencher, how: &str) {
     let scene = seed();
     let settings = Settings {
-        packets: how == "packets",
+        engine: match how {
+            "fast" => Engine::Fast,
+            _ => Engine::Book,
+        },
         ..Settings::from(Stages::ALL)
     };
-    bencher.bench(|| render(&scene, &settings, &|_| {}));
+    bencher.bench(|| raystep::engine::render(&scene, &settings, &|_| {}));
 }
 
 #[divan::bench(args = ["fake", "true"], sample_count = 60)]

@@ -176,7 +176,7 @@ fn measure_in<T: Real>(scene: &Scene, settings: &Settings) -> Measure {
                 origin: ray.origin.to_f64(),
                 direction: ray.direction.to_f64(),
             };
-            let traced = tracer.trace(ray, crate::accel::EVERY);
+            let traced = tracer.trace(ray, &mut ());
             let truth = reference_hit(&reference, &exact_ray);
 
             if let Some(truth) = truth {

@@ -18,8 +18,7 @@
 
 use crate::camera::Camera;
 use crate::real::{Precision, Vector};
-use crate::render::{Packets, Rays};
-use crate::stages::Stages;
+use crate::stages::{Engine, Stages};
 use crate::Vec3;
 
 /// One buffer, named as its PNG file is.
@@ -95,6 +94,56 @@ impl Buffer {
                 stages.intersection && stages.blinn_phong
             }
             Buffer::Bounces => stages.intersection && stages.reflection,
+        }
+    }
+}
+
+/// Rays traced, by kind: what the `rays` buffer and `raystep bench` count.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Rays {
+    /// Rays from the camera (one per pixel and sample).
+    pub primary: u64,
+    /// Rays from a hit point towards the light.
+    pub shadow: u64,
+    /// Rays from a hit point in the mirrored direction.
+    pub reflection: u64,
+}
+
+impl Rays {
+    /// Every ray, whatever its kind.
+    pub fn total(&self) -> u64 {
+        self.primary + self.shadow + self.reflection
+    }
+}
+
+impl std::ops::AddAssign for Rays {
+    fn add_assign(&mut self, other: Rays) {
+        self.primary += other.primary;
+        self.shadow += other.shadow;
+        self.reflection += other.reflection;
+    }
+}
+
+/// How a frame's pixels were traced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Packets {
+    /// One ray at a time: the book's engine (chosen, or the fast engine's
+    /// fallback for a scene it does not take in packets).
+    Off,
+    /// Four at a time, the build for any processor (two float64 lanes to a
+    /// register on x86-64: SSE2).
+    Baseline,
+    /// Four at a time, the AVX build (four float64 lanes to a register).
+    Avx,
+}
+
+impl Packets {
+    /// `"off"`, `"baseline"` or `"avx"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Packets::Off => "off",
+            Packets::Baseline => "baseline",
+            Packets::Avx => "avx",
         }
     }
 }
@@ -237,9 +286,16 @@ pub struct Frame {
     pub precision: Precision,
     /// The rays traced for the whole frame.
     pub rays: Rays,
-    /// How the pixels were traced: one ray at a time, or which build of the
-    /// packet loop ran (`raystep bench` reports it).
+    /// The engine that traced the pixels (`raystep bench` reports it).
+    pub engine: Engine,
+    /// How the fast engine traced them: one ray at a time (the book's engine), or
+    /// which build of its packet loop ran.
     pub packets: Packets,
+    /// The paths the book's [`Tracer::trace`](crate::render::Tracer::trace)
+    /// followed for this frame: every pixel's (and sample's) with the book engine,
+    /// none where the fast engine traced them in packets. A test holds the
+    /// default render to it, so that the book's code is the code that renders.
+    pub book_paths: u64,
     /// `width × height` records, row-major, top row first.
     pub pixels: Vec<PixelRecord>,
 }
@@ -256,7 +312,9 @@ impl Frame {
             camera,
             precision,
             rays: Rays::default(),
+            engine: Engine::Book,
             packets: Packets::Off,
+            book_paths: 0,
             pixels: vec![blank; camera.width as usize * camera.height as usize],
         }
     }

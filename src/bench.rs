@@ -1,9 +1,10 @@
 //! `raystep bench`: how fast a frame renders, against a yardstick, in one run.
 //!
-//! Three things are timed, their runs interleaved so that a noisy machine slows
-//! all of them alike: raystep with the threads asked for, raystep with one thread,
-//! and the [yardstick](crate::yardstick) (the tutorial's program ported plainly)
-//! with the same threads as raystep. Each is rendered once to warm up, then
+//! Four things are timed, their runs interleaved so that a noisy machine slows
+//! all of them alike: the engine asked for (`--engine`, default `fast`) with the
+//! threads asked for and with one thread, the other engine with the threads asked
+//! for, and the [yardstick](crate::yardstick) (the tutorial's program ported
+//! plainly) with the same threads. Each is rendered once to warm up, then
 //! `runs` times; the median of the runs is reported. Only the render is timed:
 //! the frame is allocated once, before the runs, and no file is written.
 
@@ -11,10 +12,12 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::aov::Frame;
+use crate::aov::{Frame, Packets, Rays};
+use crate::engine::render_into;
 use crate::error::Error;
-use crate::render::{render_into, Packets, Rays, Settings};
+use crate::render::Settings;
 use crate::scene::Scene;
+use crate::stages::Engine;
 use crate::yardstick::Yardstick;
 
 /// What `raystep bench` reports (its `--json` output).
@@ -28,6 +31,8 @@ pub struct Report {
     pub threads: usize,
     /// Timed runs of each measurement.
     pub runs: usize,
+    /// The engine the figures below are of: `"fast"` (the default) or `"book"`.
+    pub engine: &'static str,
     /// Median seconds per frame, render only, with `threads` threads.
     pub median_s: f64,
     /// Rays per frame, all kinds.
@@ -51,11 +56,19 @@ pub struct Report {
     pub yardstick_median_s: Option<f64>,
     /// `yardstick_median_s / median_s`: how many times faster raystep is.
     pub yardstick_ratio: Option<f64>,
+    /// The other engine (`"book"`, or `"fast"` under `--engine book`).
+    pub other_engine: &'static str,
+    /// Its median seconds per frame with `threads` threads.
+    pub other_median_s: f64,
+    /// `yardstick_median_s / other_median_s`.
+    pub other_yardstick_ratio: Option<f64>,
     /// Peak resident memory of the process so far, in bytes (Linux only).
     pub peak_memory_bytes: Option<u64>,
-    /// The build of the packet tracer that ran: `"avx"` (four float64 lanes to
-    /// a register), `"baseline"` (two, as on any x86-64 processor: SSE2), or
-    /// `"off"` when one ray at a time was traced.
+    /// The build of the fast engine's packet tracer that ran: `"avx"` (four
+    /// float64 lanes to a register), `"baseline"` (two, as on any x86-64
+    /// processor: SSE2), or `"off"` when one ray at a time was traced (the book
+    /// engine, or the fast engine's fallback to it for a scene it does not take in
+    /// packets).
     pub packets: &'static str,
 }
 
@@ -89,16 +102,21 @@ pub fn bench(
     let (many, one) = (pool(options.threads)?, pool(1)?);
     let yardstick = options.yardstick.then(|| Yardstick::new(scene)).flatten();
 
+    let other = Settings {
+        engine: match settings.engine {
+            Engine::Book => Engine::Fast,
+            Engine::Fast => Engine::Book,
+        },
+        ..*settings
+    };
     let mut frame = Frame::blank(scene.camera(), settings.precision);
     let mut one_frame = frame.clone();
-    let mut rays = Rays::default();
-    let mut packets = Packets::Off;
+    let mut other_frame = frame.clone();
     let mut image = Vec::new();
-    let mut jobs: Vec<Job> = vec![Box::new(|| {
-        many.install(|| render_into(scene, settings, &mut frame, &|_| {}));
-        rays = frame.rays;
-        packets = frame.packets;
-    })];
+    let mut jobs: Vec<Job> = vec![
+        Box::new(|| many.install(|| render_into(scene, settings, &mut frame, &|_| {}))),
+        Box::new(|| many.install(|| render_into(scene, &other, &mut other_frame, &|_| {}))),
+    ];
     if options.threads > 1 {
         jobs.push(Box::new(|| {
             one.install(|| render_into(scene, settings, &mut one_frame, &|_| {}))
@@ -122,9 +140,17 @@ pub fn bench(
         progress(1);
     }
     drop(jobs);
+    let rays: Rays = frame.rays;
+    let fast = if frame.engine == Engine::Fast {
+        &frame
+    } else {
+        &other_frame
+    };
+    let packets: Packets = fast.packets;
 
     let mut medians = seconds.into_iter().map(median);
     let median_s = medians.next().expect("raystep is always timed");
+    let other_median_s = medians.next().expect("both engines are always timed");
     let one_thread_median_s = (options.threads > 1).then(|| medians.next()).flatten();
     let yardstick_median_s = yardstick.is_some().then(|| medians.next()).flatten();
     let pixels = f64::from(scene.width) * f64::from(scene.height);
@@ -133,6 +159,7 @@ pub fn bench(
         height: scene.height,
         threads: options.threads,
         runs: options.runs,
+        engine: settings.engine.name(),
         median_s,
         rays: rays.total(),
         rays_primary: rays.primary,
@@ -144,6 +171,9 @@ pub fn bench(
         thread_speedup: one_thread_median_s.map(|t| t / median_s),
         yardstick_median_s,
         yardstick_ratio: yardstick_median_s.map(|t| t / median_s),
+        other_engine: other.engine.name(),
+        other_median_s,
+        other_yardstick_ratio: yardstick_median_s.map(|t| t / other_median_s),
         peak_memory_bytes: peak_memory_bytes(),
         packets: packets.name(),
     })
@@ -188,7 +218,8 @@ impl Report {
             self.runs
         ));
         line(format!(
-            "  render      {:>9.4} s per frame   {:>7.1} Mpixel/s   {:>7.1} Mray/s",
+            "  {:<11} {:>9.4} s per frame   {:>7.1} Mpixel/s   {:>7.1} Mray/s",
+            format!("{} engine", self.engine),
             self.median_s,
             self.pixels_per_s / 1e6,
             self.rays_per_s / 1e6
@@ -212,12 +243,26 @@ impl Report {
                 self.threads
             ));
         }
+        line(format!(
+            "  {:<11} {:>9.4} s per frame   {:>7.1} Mpixel/s",
+            format!("{} engine", self.other_engine),
+            self.other_median_s,
+            f64::from(self.width) * f64::from(self.height) / self.other_median_s / 1e6,
+        ));
         match (self.yardstick_median_s, self.yardstick_ratio) {
-            (Some(t), Some(r)) => line(format!(
-                "  yardstick   {t:>9.4} s per frame   speed ratio {r:.2} (raystep's speed over the \
-                 yardstick's; the tutorial's program ported plainly, {} threads)",
-                self.threads
-            )),
+            (Some(t), Some(r)) => {
+                line(format!(
+                    "  yardstick   {t:>9.4} s per frame   (the tutorial's program ported plainly, \
+                     {} threads)",
+                    self.threads
+                ));
+                let other = self.other_yardstick_ratio.unwrap_or(f64::NAN);
+                line(format!(
+                    "  speed ratio {:>9.2} {} engine, {other:.2} {} engine (each engine's speed \
+                     over the yardstick's)",
+                    r, self.engine, self.other_engine
+                ));
+            }
             _ => {
                 line("  yardstick   not run (a scene with a true plane, or --no-yardstick)".into())
             }

@@ -28,13 +28,15 @@ use plotters::style::FontStyle;
 use crate::accel::Accel;
 use crate::aov::Frame;
 use crate::bench::median;
+use crate::engine::render_into;
 use crate::error::Error;
 use crate::output::Pending;
 use crate::real::Precision;
-use crate::render::{render_into, Settings};
+use crate::render::Settings;
 use crate::scene::Scene;
 use crate::shade::shadow::Offset;
 use crate::sphere::Method;
+use crate::stages::Engine;
 use crate::stages::Stages;
 
 /// The font of the PNG charts, built in so that no system font is needed
@@ -68,7 +70,11 @@ struct Config {
 /// The settings the chart compares: the default, and one change from it each (and
 /// the tutorial's program).
 fn configs(max_depth: u32) -> Vec<Config> {
-    let default = Settings::from(Stages::ALL);
+    // Speed is the fast engine's; the book's engine is one point of the chart.
+    let default = Settings {
+        engine: Engine::Fast,
+        ..Settings::from(Stages::ALL)
+    };
     let with = |label, change: &dyn Fn(&mut Settings)| {
         let mut settings = default;
         change(&mut settings);
@@ -90,14 +96,17 @@ fn configs(max_depth: u32) -> Vec<Config> {
         with("default", &|_| {}),
         Config {
             label: "tutorial",
-            settings: Settings::tutorial(Stages::ALL),
+            settings: Settings {
+                engine: Engine::Fast,
+                ..Settings::tutorial(Stages::ALL)
+            },
             max_depth,
         },
         with("f32", &|s| s.precision = Precision::F32),
         with("naive", &|s| s.method = Method::Naive),
         with("fixed:1e-5", &|s| s.offset = Offset::TUTORIAL),
         with("accel off", &|s| s.accel = Accel::Off),
-        with("packets off", &|s| s.packets = false),
+        with("book engine", &|s| s.engine = Engine::Book),
         with("early stop off", &|s| s.early_stop = false),
         with("spp 4", &|s| s.spp = 4),
         with("spp 16", &|s| s.spp = 16),
@@ -284,6 +293,7 @@ pub fn scale(
             }
             let settings = Settings {
                 accel,
+                engine: Engine::Fast,
                 ..Settings::from(Stages::ALL)
             };
             let mut frame = Frame::blank(scene.camera(), settings.precision);

@@ -1,22 +1,23 @@
 //! `raystep explain`: the whole story of one pixel, in the tutorial's terms.
 //!
-//! The story is told by following the pixel's path again with the same functions
-//! the render calls (the intersection methods, the offset, the shadow test,
-//! Blinn-Phong, the reflection), writing down every number on the way. It uses the
-//! plain loop over the objects: the tile masks and the BVH never change a result
-//! (`tests/speed.rs`), and the plain loop is the one whose every test can be told.
-//! `tests/explain.rs` checks, pixel by pixel, that the story ends where the render
-//! did.
+//! The story is told by watching the book's own [`Tracer::pixel`] and
+//! [`Tracer::trace`] follow the pixel's path: they tell an [`Observer`] each step
+//! (the ray, the hit, the shadow ray, Blinn-Phong's terms, what is added, why the
+//! path ends), and the observer here writes every number down. So an edit to the
+//! book's code changes the story as it changes the render. Beside what the trace
+//! reports, the story tests every object against each segment's ray in the plain
+//! loop, to show each one's verdict. `tests/explain.rs` checks, pixel by pixel,
+//! that the story ends where the render did.
 
 use serde::Serialize;
 
+use crate::aov::Rays;
 use crate::output::to_byte;
 use crate::ray::Ray;
 use crate::real::{Real, Vector};
-use crate::render::{direction_colour, Settings, Tracer, HALF_STEP};
-use crate::scene::{nearest_hit, Object, Role, Scene, Shape};
-use crate::shade::blinn_phong::{self, Viewer};
-use crate::shade::{reflection, shadow};
+use crate::render::{direction_colour, End, Observer, Settings, Tracer};
+use crate::scene::{nearest_hit, Hit, Object, Role, Scene, Shape};
+use crate::shade::blinn_phong::{Terms, Viewer};
 use crate::sphere::Method;
 use crate::Vec3;
 
@@ -179,108 +180,109 @@ pub fn explain(scene: &Scene, settings: &Settings, x: u32, y: u32) -> Explanatio
 fn explain_in<T: Real>(scene: &Scene, settings: &Settings, x: u32, y: u32) -> Explanation {
     let tracer = Tracer::<T>::new(scene, settings);
     let (row, col) = (y, x);
-    let primary = tracer.camera.primary_ray::<T>(row, col);
-    let mut story = Explanation {
-        x,
-        y,
-        stages: settings.stages.to_string(),
-        rules: rules(settings),
-        screen_point: tracer
-            .camera
-            .screen_point::<T>(row, col)
-            .to_f64()
-            .to_array(),
-        primary: info(&primary),
-        depth: None,
-        segments: Vec::new(),
-        end: String::new(),
-        unclipped: [0.0; 3],
-        colour: [0.0; 3],
-        samples: None,
-        rays: [1, 0, 0],
+    let mut story = Story {
+        tracer: &tracer,
+        told: Explanation {
+            x,
+            y,
+            stages: settings.stages.to_string(),
+            rules: rules(settings),
+            screen_point: tracer
+                .camera
+                .screen_point::<T>(row, col)
+                .to_f64()
+                .to_array(),
+            primary: RayInfo {
+                origin: [0.0; 3],
+                direction: [0.0; 3],
+            },
+            depth: None,
+            segments: Vec::new(),
+            end: String::new(),
+            unclipped: [0.0; 3],
+            colour: [0.0; 3],
+            samples: None,
+            rays: [0; 3],
+        },
+        sum: T::Vec3::ZERO,
+        rays: Rays::default(),
     };
+    // The book's own pixel, watched: the story is what the render computes.
+    let traced = tracer.pixel(row, col, &mut story);
+    let Story {
+        mut told,
+        sum,
+        rays,
+        ..
+    } = story;
+    told.colour = traced.colour.to_array();
+    told.rays = [rays.primary, rays.shadow, rays.reflection];
     if !settings.stages.intersection {
-        let colour = direction_colour(primary.direction.to_f64());
-        story.end = "only the rays stage is on: the colour shows the ray's direction, \
-                     each component mapped from [−1, 1] to [0, 1]"
+        told.end = "only the rays stage is on: the colour shows the ray's direction, \
+                    each component mapped from [−1, 1] to [0, 1]"
             .into();
-        story.unclipped = colour.to_array();
-        story.colour = colour.clamp(Vec3::ZERO, Vec3::ONE).to_array();
-        return story;
+        told.unclipped = direction_colour(Vec3::from_array(told.primary.direction)).to_array();
+        return told;
     }
-    let segments = if settings.stages.reflection {
-        tracer.max_depth
-    } else {
-        1
-    };
-    let mut sum = T::Vec3::ZERO;
-    let mut weight = T::of(1.0);
-    let mut ray = primary;
-    story.end = format!("the path used all {segments} of its segments");
-    for index in 0..segments {
-        if index > 0 {
-            story.rays[2] += 1;
-        }
-        let tests = tracer
-            .objects
-            .iter()
-            .enumerate()
-            .map(|(i, o)| test(i, o, &ray, tracer.method))
-            .collect();
-        let mut segment = Segment {
+    told.unclipped = sum.to_f64().to_array();
+    if settings.spp > 1 {
+        let mut all = rays;
+        let mean = crate::samples::mean(&tracer, row, col, settings.spp, &mut all);
+        told.samples = Some(Samples {
+            spp: settings.spp,
+            // As the record keeps it: in float32.
+            colour: mean.as_vec3().as_dvec3().to_array(),
+            rays: all.total(),
+        });
+    }
+    told
+}
+
+/// The observer that writes the story down as the book's `trace` goes.
+struct Story<'a, T: Real> {
+    tracer: &'a Tracer<T>,
+    told: Explanation,
+    /// The path's sum so far.
+    sum: T::Vec3,
+    /// The rays the path traced.
+    rays: Rays,
+}
+
+impl<T: Real> Story<'_, T> {
+    /// The hit of the segment being told.
+    fn hit(&mut self) -> &mut HitInfo {
+        let segment = self.told.segments.last_mut();
+        let hit = segment.and_then(|s| s.hit.as_mut());
+        hit.expect("the book's trace reports a hit before what it computes there")
+    }
+}
+
+impl<T: Real> Observer<T> for Story<'_, T> {
+    fn primary(&mut self, ray: &Ray<T>) {
+        Observer::<T>::primary(&mut self.rays, ray);
+        self.told.primary = info(ray);
+    }
+
+    fn segment(&mut self, index: u32, ray: &Ray<T>, weight: T) {
+        self.rays.segment(index, ray, weight);
+        let (objects, method) = (&self.tracer.objects, self.tracer.method);
+        self.told.segments.push(Segment {
             index,
-            ray: info(&ray),
+            ray: info(ray),
             weight: weight.to_f64(),
-            tests,
+            tests: (objects.iter().enumerate())
+                .map(|(i, o)| test(i, o, ray, method))
+                .collect(),
             hit: None,
-        };
-        let Some(hit) = nearest_hit(&tracer.objects, &ray, tracer.method) else {
-            story.end = if index == 0 {
-                "the primary ray hits nothing: the pixel is black (the tutorial has no sky colour)"
-                    .into()
-            } else {
-                format!("reflection {index} hits nothing: the sky adds no light")
-            };
-            story.segments.push(segment);
-            break;
-        };
-        let object = &tracer.objects[hit.object];
-        let point = ray.at(hit.t);
-        let normal = object.normal_at(point, &ray);
-        let shifted = shadow::step_off(point, normal, object, tracer.offset);
-        let to_light = (tracer.light.position - shifted).normalize();
-        let shadow = settings.stages.shadow.then(|| {
-            story.rays[1] += 1;
-            let light_distance = tracer.light.position.distance(point);
-            let shadow_ray = Ray {
-                origin: shifted,
-                direction: to_light,
-            };
-            let blocker = nearest_hit(&tracer.objects, &shadow_ray, tracer.method);
-            ShadowInfo {
-                ray: info(&shadow_ray),
-                light_distance: light_distance.to_f64(),
-                blocker: blocker.map(|b| (b.object, b.t.to_f64())),
-            }
         });
-        let lit = shadow
-            .as_ref()
-            .is_none_or(|s| s.blocker.is_none_or(|(_, t)| t >= s.light_distance));
-        if index == 0 {
-            story.depth = Some(hit.t.to_f64());
+    }
+
+    fn hit(&mut self, hit: &Hit<T>, point: T::Vec3, normal: T::Vec3, shifted: T::Vec3) {
+        if self.told.segments.len() == 1 {
+            self.told.depth = Some(hit.t.to_f64());
         }
-        let viewer = match tracer.viewer {
-            Viewer::Camera => T::Vec3::of(tracer.camera.position),
-            Viewer::RayOrigin => ray.origin,
-        };
-        let to_viewer = (viewer - point).normalize();
-        let terms = (lit && settings.stages.blinn_phong).then(|| {
-            blinn_phong::terms(&object.material, &tracer.light, normal, to_light, to_viewer)
-        });
-        let illumination = lit.then(|| terms.map_or(object.material.diffuse, |t| t.sum()));
-        if let Some(light) = illumination {
-            sum += light * weight;
-        }
+        let sum = self.sum.to_f64().to_array();
+        let segment = self.told.segments.last_mut().expect("a segment has begun");
         segment.hit = Some(HitInfo {
             object: hit.object,
             t: hit.t.to_f64(),
@@ -288,56 +290,78 @@ fn explain_in<T: Real>(scene: &Scene, settings: &Settings, x: u32, y: u32) -> Ex
             normal: normal.to_f64().to_array(),
             shifted: shifted.to_f64().to_array(),
             offset: (shifted - point).length().to_f64(),
-            shadow,
-            lit,
-            shading: terms.map(|t| Shading {
-                to_light: to_light.to_f64().to_array(),
-                to_viewer: to_viewer.to_f64().to_array(),
-                l_dot_n: t.l_dot_n.to_f64(),
-                n_dot_h: t.n_dot_h.to_f64(),
-                exponent: (object.material.shininess / T::of(4.0)).to_f64(),
-                highlight: t.highlight.to_f64(),
-                ambient: t.ambient.to_f64().to_array(),
-                diffuse: t.diffuse.to_f64().to_array(),
-                specular: t.specular.to_f64().to_array(),
-            }),
-            illumination: illumination.map(|c| c.to_f64().to_array()),
-            sum: sum.to_f64().to_array(),
+            shadow: None,
+            lit: true,
+            shading: None,
+            illumination: None,
+            sum,
         });
-        story.segments.push(segment);
-        if !lit {
-            story.end = format!(
-                "the point of segment {index} does not see the light: the path ends there \
-                 and adds nothing more (the tutorial's rule)"
-            );
-            break;
-        }
-        weight = weight * object.material.reflection;
-        ray = reflection::reflected_ray(shifted, &ray, normal);
-        let left = (segments - index - 1) as usize;
-        if let Some(reach) = tracer.reach.get(left) {
-            if left > 0 && weight.to_f64() * reach < HALF_STEP {
-                story.end = format!(
-                    "early stop after segment {index}: the weight left, {}, times the most \
-                     {left} more segments can add, {}, is below half an 8-bit step",
-                    num(weight.to_f64()),
-                    num(*reach)
-                );
-                break;
+    }
+
+    fn shadow_ray(&mut self, ray: &Ray<T>, light_distance: T) {
+        self.rays.shadow_ray(ray, light_distance);
+        // The nearest blocker, to tell where it stands (the render asks only
+        // whether there is one before the light).
+        let blocker = nearest_hit(&self.tracer.objects, ray, self.tracer.method);
+        let light_distance = light_distance.to_f64();
+        let hit = self.hit();
+        hit.lit = blocker.is_none_or(|b| b.t.to_f64() >= light_distance);
+        hit.shadow = Some(ShadowInfo {
+            ray: info(ray),
+            light_distance,
+            blocker: blocker.map(|b| (b.object, b.t.to_f64())),
+        });
+    }
+
+    fn shaded(&mut self, t: &Terms<T>, to_light: T::Vec3, to_viewer: T::Vec3) {
+        let object = self.hit().object;
+        let shininess = self.tracer.objects[object].material.shininess;
+        self.hit().shading = Some(Shading {
+            to_light: to_light.to_f64().to_array(),
+            to_viewer: to_viewer.to_f64().to_array(),
+            l_dot_n: t.l_dot_n.to_f64(),
+            n_dot_h: t.n_dot_h.to_f64(),
+            exponent: (shininess / T::of(4.0)).to_f64(),
+            highlight: t.highlight.to_f64(),
+            ambient: t.ambient.to_f64().to_array(),
+            diffuse: t.diffuse.to_f64().to_array(),
+            specular: t.specular.to_f64().to_array(),
+        });
+    }
+
+    fn added(&mut self, illumination: T::Vec3, sum: T::Vec3) {
+        self.sum = sum;
+        let hit = self.hit();
+        hit.illumination = Some(illumination.to_f64().to_array());
+        hit.sum = sum.to_f64().to_array();
+    }
+
+    fn end(&mut self, why: End) {
+        let index = self.told.segments.len().saturating_sub(1);
+        self.told.end = match why {
+            End::Miss if index == 0 => {
+                "the primary ray hits nothing: the pixel is black (the tutorial has no sky colour)"
+                    .into()
             }
-        }
+            End::Miss => format!("reflection {index} hits nothing: the sky adds no light"),
+            End::Shadow => {
+                self.hit().lit = false;
+                format!(
+                    "the point of segment {index} does not see the light: the path ends there \
+                     and adds nothing more (the tutorial's rule)"
+                )
+            }
+            End::EarlyStop { weight, left } if left > 0 => format!(
+                "early stop after segment {index}: the weight left, {}, times the most \
+                 {left} more segments can add, {}, is below half an 8-bit step",
+                num(weight),
+                num(self.tracer.reach[left])
+            ),
+            End::EarlyStop { .. } | End::Done => {
+                format!("the path used all {} of its segments", index + 1)
+            }
+        };
     }
-    story.unclipped = sum.to_f64().to_array();
-    story.colour = sum.clamp01().to_f64().to_array();
-    if tracer.spp > 1 {
-        let (record, rays) = tracer.pixel(row, col);
-        story.samples = Some(Samples {
-            spp: tracer.spp,
-            colour: record.colour.map(f64::from),
-            rays: rays.total(),
-        });
-    }
-    story
 }
 
 /// The test of object `index` against `ray`, with its numbers and verdict.

@@ -10,7 +10,7 @@
 
 use std::fmt::Write;
 
-use crate::render::{splitmix64, unit_interval};
+use crate::samples::{splitmix64, unit_interval};
 use crate::scene::{Material, Object, Role, Scene, Shape};
 use crate::sphere::Sphere;
 use crate::Vec3;

@@ -17,7 +17,7 @@
 //! The modules below are listed in the order the book introduces them, so this
 //! file reads as its table of contents.
 // One place only, with its reason: the call of the packet loop's AVX build once
-// the processor is found to have AVX (`Tracer::packet_row`, render.rs).
+// the processor is found to have AVX (`Fast::packet_row`, fast.rs).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -43,10 +43,13 @@ pub mod contact;
 pub mod output;
 pub mod page;
 pub mod render;
+pub mod samples;
 pub mod stages;
 // Speed: skipping tests that cannot succeed, and four rays at once.
 pub mod accel;
 pub mod bvh;
+pub mod engine;
+pub mod fast;
 pub mod lanes;
 pub mod packet;
 // The command line, its errors, and the tools around the renderer.

@@ -1,4 +1,4 @@
-//! Four rays at once: [`Tracer::trace`] for four neighbouring pixels, side by
+//! Four rays at once: the book's [`Tracer::trace`](crate::render::Tracer::trace) for four neighbouring pixels, side by
 //! side in the lanes of SIMD registers.
 //!
 //! The book's tracer follows one ray at a time. Each step of it waits for the one
@@ -29,14 +29,14 @@
 //!
 //! The packet loop is compiled twice, once for any x86-64 processor and once for
 //! one with AVX, whose registers hold four float64 lanes instead of two; which one
-//! runs is chosen when the program runs ([`Tracer::packet_row`], `--avx on|off`).
+//! runs is chosen when the program runs ([`Fast::packet_row`], `--avx on|off`).
 //! That is why the functions here are `#[inline(always)]`: only what is inlined
 //! into the AVX build's entry is compiled for AVX. The two give the same bits.
 //!
 //! Even four at a time, a packet spends most of its time waiting on a square root
 //! or a division whose result the next step needs. So two things are computed
 //! earlier than the book's order would put them, to overlap with other waiting:
-//! [`Tracer::packet_row`] makes the primary rays of [`BATCH`] packets before it
+//! [`Fast::packet_row`] makes the primary rays of [`BATCH`] packets before it
 //! traces any of them, and `trace_packet` starts the light's distance and the
 //! direction to the viewer as soon as the hit point is known.
 //!
@@ -50,10 +50,13 @@ use std::borrow::Cow;
 
 use crate::accel::{EVERY, TILE};
 use crate::aov::PixelRecord;
+use crate::aov::Rays;
 use crate::bvh::PacketSearch;
+use crate::fast::Fast;
 use crate::lanes::{components, convert, each, powi, F64s, Lanes, ALL, V3, WIDTH};
 use crate::real::{Real, Vector};
-use crate::render::{direction_colour, stratified, Rays, Tracer, HALF_STEP};
+use crate::render::{direction_colour, HALF_STEP};
+use crate::samples::stratified;
 use crate::scene::{Light, Object, Shape};
 use crate::shade::blinn_phong::{whole_exponent, Viewer};
 use crate::shade::shadow::{Offset, AUTO_FACTOR};
@@ -66,7 +69,7 @@ const _: () = assert!(TILE.0 as usize % WIDTH == 0);
 /// The most objects the packet tracer takes (one bit each in a search mask).
 pub const MAX_OBJECTS: usize = 64;
 
-/// How many packets' primary rays [`Tracer::packet_row`] makes before it traces
+/// How many packets' primary rays [`Fast::packet_row`] makes before it traces
 /// them.
 pub const BATCH: usize = 16;
 
@@ -244,7 +247,7 @@ impl<T: Real> Packet<T> {
     }
 }
 
-/// What [`Tracer::trace_packet`] brings back, lane by lane: the colour, the first
+/// What [`Fast::trace_packet`] brings back, lane by lane: the colour, the first
 /// hit (where `hit` has the lane's bit) and the rays traced.
 struct Traced4<T: Real> {
     /// The sum of the path's light, not yet clipped.
@@ -349,7 +352,7 @@ impl<T: Real> Traced4<T> {
 ///
 /// [`scene::consider`]: crate::scene::consider
 struct Nearest<'a, T: Real> {
-    tracer: &'a Tracer<T>,
+    tracer: &'a Fast<T>,
     ray: &'a Packet<T>,
     alive: u32,
     t: T::Lanes,
@@ -413,7 +416,7 @@ impl<T: Real> Nearest<'_, T> {
 
 /// The lanes whose shadow ray is blocked so far.
 struct Blocked<'a, T: Real> {
-    tracer: &'a Tracer<T>,
+    tracer: &'a Fast<T>,
     ray: &'a Packet<T>,
     distance: T::Lanes,
     alive: u32,
@@ -470,11 +473,11 @@ fn count(counts: &mut [u32; WIDTH], bits: u32) {
     }
 }
 
-impl<T: Real> Tracer<T> {
+impl<T: Real> Fast<T> {
     // ANCHOR: packet
     /// The records of pixels `col`, `col + 1`, … of row `row`, one per element of
     /// `out` (at most [`WIDTH`]), traced as one packet from their primary rays `ray`
-    /// ([`Tracer::pixel_rays`]): what [`Tracer::pixel`] gives for each of them, and
+    /// ([`Fast::pixel_rays`]): what the book's [`Tracer::pixel`](crate::render::Tracer::pixel) gives for each of them, and
     /// the rays they took.
     #[inline(always)]
     pub fn pixel_packet(
@@ -494,7 +497,7 @@ impl<T: Real> Tracer<T> {
         debug_assert!(self.packets, "a tracer made without packets");
         let lanes = ALL >> (WIDTH - n);
         let mut total = Rays::default();
-        if !self.stages.intersection {
+        if !self.book.stages.intersection {
             for (pixel, d) in out.iter_mut().zip(ray.direction.to_vectors()) {
                 let colour = direction_colour(d.to_f64()).clamp(Vec3::ZERO, Vec3::ONE);
                 *pixel = PixelRecord::new(colour, None, 0, 1);
@@ -530,13 +533,13 @@ impl<T: Real> Tracer<T> {
     // ANCHOR_END: packet
 
     /// The primary rays of pixels `col`, `col + 1`, … of row `row`: the packet
-    /// [`Tracer::pixel_packet`] traces from there. Lanes past the image's right
+    /// [`Fast::pixel_packet`] traces from there. Lanes past the image's right
     /// edge repeat its last pixel (their records are dropped).
     #[inline(always)]
     pub fn pixel_rays(&self, row: u32, col: u32) -> Packet<T> {
         // The screen points, as the camera gives them: x read from its table.
         let x = T::Lanes::from_array(each(|i| self.columns[self.column(col, i) as usize]));
-        let [_, y, _] = components::<T>(self.camera.screen_point::<T>(row, 0));
+        let [_, y, _] = components::<T>(self.book.camera.screen_point::<T>(row, 0));
         self.rays_to(x, T::Lanes::splat(y))
     }
 
@@ -544,7 +547,7 @@ impl<T: Real> Tracer<T> {
     /// last column past its right edge.
     #[inline(always)]
     fn column(&self, col: u32, i: usize) -> u32 {
-        (col + i as u32).min(self.camera.width - 1)
+        (col + i as u32).min(self.book.camera.width - 1)
     }
 
     /// The rays from the eye through the screen at fractional (`rows[i]`,
@@ -552,7 +555,7 @@ impl<T: Real> Tracer<T> {
     /// computes each.
     #[inline(always)]
     fn rays_through(&self, rows: [f64; WIDTH], cols: [f64; WIDTH]) -> Packet<T> {
-        let camera = &self.camera;
+        let camera = &self.book.camera;
         let s = &camera.screen;
         // `from + i·(to − from)/(n − 1)`, as the camera's grid.
         let grid = |from: f64, to: f64, at: [f64; WIDTH], n: u32| {
@@ -573,7 +576,7 @@ impl<T: Real> Tracer<T> {
     /// [`Ray::towards`](crate::ray::Ray::towards) makes each.
     #[inline(always)]
     fn rays_to(&self, x: T::Lanes, y: T::Lanes) -> Packet<T> {
-        let origin = V3::splat(T::Vec3::of(self.camera.position));
+        let origin = V3::splat(T::Vec3::of(self.book.camera.position));
         let target = V3::new(x, y, T::Lanes::splat(T::of(0.0)));
         Packet {
             origin,
@@ -582,18 +585,18 @@ impl<T: Real> Tracer<T> {
     }
 
     // ANCHOR: trace_packet
-    /// [`Tracer::trace`] for the four rays of `primary`, of which the lanes `lanes`
+    /// The book's [`Tracer::trace`](crate::render::Tracer::trace) for the four rays of `primary`, of which the lanes `lanes`
     /// count.
     #[inline(always)]
     fn trace_packet(&self, mut ray: Packet<T>, lanes: u32, candidates: u64) -> Traced4<T> {
-        let segments = if self.stages.reflection {
-            self.max_depth
+        let segments = if self.book.stages.reflection {
+            self.book.max_depth
         } else {
             1
         };
         let mut traced = Traced4::blank();
         let mut weight = T::Lanes::splat(T::of(1.0));
-        let light = V3::<T>::splat(self.light.position);
+        let light = V3::<T>::splat(self.book.light.position);
         let mut alive = lanes; // the lanes whose path goes on
         for segment in 0..segments {
             if segment > 0 {
@@ -607,7 +610,7 @@ impl<T: Real> Tracer<T> {
                 break;
             }
             let made;
-            let object = match (self.bvh.is_some(), self.same_object(&which, alive)) {
+            let object = match (self.book.bvh.is_some(), self.same_object(&which, alive)) {
                 (false, Some(index)) => &self.packed[index],
                 (false, None) => {
                     made = Packed::blend(which.map(|w| &self.packed[w]));
@@ -616,11 +619,11 @@ impl<T: Real> Tracer<T> {
                 // The many objects of a BVH are not kept in lanes: made for the hit
                 // (read for the lanes alive only, when they hit one object).
                 (true, Some(index)) => {
-                    made = Packed::new(&self.objects[index], &self.light);
+                    made = Packed::new(&self.book.objects[index], &self.book.light);
                     &made
                 }
                 (true, None) => {
-                    made = Packed::gather(which.map(|w| &self.objects[w]), &self.light);
+                    made = Packed::gather(which.map(|w| &self.book.objects[w]), &self.book.light);
                     &made
                 }
             };
@@ -628,14 +631,14 @@ impl<T: Real> Tracer<T> {
             // The light's distance and the direction to the viewer, made before
             // they are needed (if they are): their square roots and divisions then
             // overlap the normal's and the shadow test's.
-            let light_distance = if self.stages.shadow {
+            let light_distance = if self.book.stages.shadow {
                 Some((light - point).length())
             } else {
                 None
             };
-            let to_viewer = if self.stages.blinn_phong {
-                let viewer = match self.viewer {
-                    Viewer::Camera => V3::splat(T::Vec3::of(self.camera.position)),
+            let to_viewer = if self.book.stages.blinn_phong {
+                let viewer = match self.book.viewer {
+                    Viewer::Camera => V3::splat(T::Vec3::of(self.book.camera.position)),
                     Viewer::RayOrigin => ray.origin,
                 };
                 Some((viewer - point).normalize())
@@ -700,7 +703,7 @@ impl<T: Real> Tracer<T> {
             };
             // Early stop: nothing the rest of the path adds can change the pixel.
             let left = (segments - segment - 1) as usize;
-            if let Some(&reach) = self.reach.get(left) {
+            if let Some(&reach) = self.book.reach.get(left) {
                 let most = convert::<T, f64>(weight) * F64s::splat(reach);
                 alive &= !most.lt(F64s::splat(HALF_STEP)).bits();
                 if alive == 0 {
@@ -763,7 +766,7 @@ impl<T: Real> Tracer<T> {
     /// until no lane is still searching.
     #[inline(always)]
     fn search_packet(&self, ray: &Packet<T>, objects: u64, search: &mut impl PacketSearch) {
-        if let Some(bvh) = &self.bvh {
+        if let Some(bvh) = &self.book.bvh {
             return bvh.search_packet(&ray.origin, &ray.direction, search);
         }
         let mut left = objects & self.every_object();
@@ -781,7 +784,7 @@ impl<T: Real> Tracer<T> {
     fn shape(&self, index: usize) -> Cow<'_, Shape4<T>> {
         match self.packed.get(index) {
             Some(p) => Cow::Borrowed(&p.shape),
-            None => Cow::Owned(Shape4::new(&self.objects[index])),
+            None => Cow::Owned(Shape4::new(&self.book.objects[index])),
         }
     }
 
@@ -816,7 +819,7 @@ impl<T: Real> Tracer<T> {
         if d_dot_f.gt(zero).bits() == ALL {
             return (zero, T::Lanes::mask(0));
         }
-        let (near, far, hit) = match self.method {
+        let (near, far, hit) = match self.book.method {
             Method::Stable => {
                 let h = -d_dot_f;
                 let closest = f + d.scale(h);
@@ -881,7 +884,7 @@ impl<T: Real> Tracer<T> {
         point: V3<T>,
         normal: V3<T>,
     ) -> V3<T> {
-        match self.offset {
+        match self.book.offset {
             Offset::Fixed(step) => point + normal.scale(T::Lanes::splat(T::of(step))),
             Offset::Auto => {
                 let shape = &object.shape;

@@ -17,6 +17,12 @@ pub struct Ray<T: Real = f64> {
 
 // ANCHOR: ray
 impl<T: Real> Ray<T> {
+    /// The ray from `origin` along the unit vector `direction`.
+    #[inline]
+    pub fn new(origin: T::Vec3, direction: T::Vec3) -> Ray<T> {
+        Ray { origin, direction }
+    }
+
     /// The ray that starts at `origin` and passes through `target`.
     #[inline]
     pub fn towards(origin: T::Vec3, target: T::Vec3) -> Ray<T> {

@@ -6,6 +6,35 @@
 
 use std::fmt;
 
+/// Which tracer renders (`--engine`). Both give the same bits for every pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum Engine {
+    /// The tracer the chapters show, one ray at a time in plain code
+    /// ([`crate::render`]): the default wherever a reader looks at pictures.
+    #[default]
+    Book,
+    /// The same tracer, four rays at a time in SIMD lanes, with tile masks and a
+    /// packet walk of the BVH ([`crate::fast`]): `raystep bench` and `chart`. It
+    /// traces what it does not support with the book's engine.
+    Fast,
+}
+
+impl Engine {
+    /// `"book"` or `"fast"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::Book => "book",
+            Engine::Fast => "fast",
+        }
+    }
+}
+
+impl fmt::Display for Engine {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// One step of the tutorial, in the order the book introduces them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, clap::ValueEnum)]
 pub enum Stage {

@@ -430,7 +430,7 @@ fn the_charts_shown_exist_and_their_numbers_are_the_csv_files() {
     assert!(rmse("f32") > 2.0 * rmse("default") - 0.1);
     assert_eq!(rmse("naive"), rmse("default"));
     assert_eq!(rmse("accel off"), rmse("default"));
-    assert_eq!(rmse("packets off"), rmse("default"));
+    assert_eq!(rmse("book engine"), rmse("default"));
     assert_eq!(rmse("early stop off"), rmse("default"));
 }
 

@@ -48,14 +48,15 @@ use proptest::sample::Index;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
 use raystep::accel::Accel;
 use raystep::aov::{PixelRecord, NO_OBJECT};
+use raystep::engine::render;
 use raystep::real::Precision;
-use raystep::render::{render, Settings};
+use raystep::render::Settings;
 use raystep::scene::Scene;
 use raystep::scene_file::{parse_sized, SizeOverride, MAX_MAGNITUDE, SEED_TOML};
 use raystep::shade::blinn_phong::Viewer;
 use raystep::shade::shadow::Offset;
 use raystep::sphere::Method;
-use raystep::stages::{Stage, Stages};
+use raystep::stages::{Engine, Stage, Stages};
 
 /// The name every fuzzed scene is parsed under: errors must name it.
 const FILE: &str = "fuzz.toml";
@@ -156,7 +157,7 @@ fn any_settings() -> impl Strategy<Value = Settings> {
         any::<bool>(),
     )
         .prop_map(
-            |(last, without, f32, method, offset, viewer, accel, spp, early_stop, packets, avx)| {
+            |(last, without, f32, method, offset, viewer, accel, spp, early_stop, fast, avx)| {
                 // `--stage last --without ...`, or all up to `last` if that set is refused.
                 let stages = Stages::select(last, &without).unwrap_or(Stages::up_to(last));
                 Settings {
@@ -167,7 +168,7 @@ fn any_settings() -> impl Strategy<Value = Settings> {
                     accel,
                     spp,
                     early_stop,
-                    packets,
+                    engine: if fast { Engine::Fast } else { Engine::Book },
                     avx,
                     ..Settings::from(stages)
                 }
@@ -225,22 +226,22 @@ fn renders_soundly(scene: &Scene, settings: &[(&str, Settings)]) -> Result<(), S
                 ));
             }
         }
-        // Acceleration skips only tests that cannot succeed, and packets compute
-        // the same numbers four at a time: the book's plain loop over every object,
-        // one ray at a time, must give the very same records.
-        if s.accel != Accel::Off || s.packets {
+        // Acceleration skips only tests that cannot succeed, and the fast engine
+        // computes the same numbers four at a time: the book's engine with its plain
+        // loop over every object must give the very same records.
+        if s.accel != Accel::Off || s.engine == Engine::Fast {
             let plain = render(
                 scene,
                 &Settings {
                     accel: Accel::Off,
-                    packets: false,
+                    engine: Engine::Book,
                     ..*s
                 },
                 &|_| {},
             );
             if let Some(i) = (0..frame.pixels.len()).find(|&i| frame.pixels[i] != plain.pixels[i]) {
                 return Err(format!(
-                    "{name} ({s:?}): pixel (row {}, col {}) differs with --accel off --packets off: {:?} against {:?}",
+                    "{name} ({s:?}): pixel (row {}, col {}) differs with --accel off --engine book: {:?} against {:?}",
                     i / width,
                     i % width,
                     frame.pixels[i],

@@ -4,7 +4,6 @@
 
 mod common;
 
-use raystep::accel::EVERY;
 use raystep::accuracy::surface_distance;
 use raystep::output::{exr_bytes, png_bytes};
 use raystep::ray::Ray;
@@ -59,7 +58,7 @@ fn every_depth_equals_the_geometric_distance_to_the_sphere() {
             let ray = tracer.camera.primary_ray::<f64>(row, col);
             let along = (c - ray.origin).dot(ray.direction);
             let miss2 = (c - ray.origin).length_squared() - along * along;
-            let traced = tracer.trace(ray, EVERY);
+            let traced = tracer.trace(ray, &mut ());
             match traced.first {
                 Some(hit) => {
                     hits += 1;
@@ -156,14 +155,15 @@ fn a_point_behind_an_occluder_is_in_shadow_and_black() {
         origin: Vec3::new(0.0, 1.0, -2.0),
         direction: -Vec3::Y,
     };
-    let blocked = Tracer::<f64>::new(&occluder_scene(0.0), &Stages::ALL.into()).trace(down, EVERY);
+    let blocked =
+        Tracer::<f64>::new(&occluder_scene(0.0), &Stages::ALL.into()).trace(down, &mut ());
     let hit = blocked.first.unwrap();
     assert_eq!(hit.depth, 1.0);
     assert!(!hit.lit);
     assert_eq!(blocked.colour, Vec3::ZERO);
 
     // The same point with the occluder moved aside is lit.
-    let open = Tracer::<f64>::new(&occluder_scene(3.0), &Stages::ALL.into()).trace(down, EVERY);
+    let open = Tracer::<f64>::new(&occluder_scene(3.0), &Stages::ALL.into()).trace(down, &mut ());
     assert!(open.first.unwrap().lit);
     assert!(open.colour.max_element() > 0.5);
 
@@ -171,7 +171,7 @@ fn a_point_behind_an_occluder_is_in_shadow_and_black() {
     let no_shadow = Stages::select(Stage::Plane, &[Stage::Shadow]).unwrap();
     assert!(
         Tracer::<f64>::new(&occluder_scene(0.0), &no_shadow.into())
-            .trace(down, EVERY)
+            .trace(down, &mut ())
             .first
             .unwrap()
             .lit
@@ -200,7 +200,7 @@ fn recast(settings: Settings) -> Recast {
     for row in 0..scene.height {
         for col in 0..scene.width {
             let ray = tracer.camera.primary_ray::<f64>(row, col);
-            let Some(hit) = tracer.trace(ray, EVERY).first else {
+            let Some(hit) = tracer.trace(ray, &mut ()).first else {
                 continue;
             };
             let object = &tracer.objects[hit.object];
@@ -312,7 +312,7 @@ fn without_shadow_every_hit_is_plain_blinn_phong_even_where_it_is_negative() {
             }
             assert_eq!(p.shadow, 1.0);
             let ray = tracer.camera.primary_ray::<f64>(row, col);
-            let hit = tracer.trace(ray, EVERY).first.unwrap();
+            let hit = tracer.trace(ray, &mut ()).first.unwrap();
             let object = &tracer.objects[hit.object];
             let point = ray.at(hit.depth);
             let shifted = step_off(point, hit.normal, object, settings.offset);

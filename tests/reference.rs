@@ -3,7 +3,7 @@
 mod common;
 
 use raystep::render::Settings;
-use raystep::stages::Stages;
+use raystep::stages::{Engine, Stages};
 
 /// raystep computes in float64 like the tutorial's program and stores float32, as
 /// the PFM does. Measured on this machine: every float32 value is identical (a
@@ -14,11 +14,24 @@ use raystep::stages::Stages;
 const TOLERANCE: f32 = 1e-6;
 
 #[test]
-fn every_stage_on_reproduces_the_tutorials_figure_1() {
+fn every_stage_on_reproduces_the_tutorials_figure_1_with_the_book_engine() {
+    reproduces_figure_1(Engine::Book);
+}
+
+#[test]
+fn every_stage_on_reproduces_the_tutorials_figure_1_with_the_fast_engine() {
+    reproduces_figure_1(Engine::Fast);
+}
+
+fn reproduces_figure_1(engine: Engine) {
     let (w, h, reference) = common::read_pfm(include_bytes!("data/seed-300x200.pfm"));
     assert_eq!((w, h), (300, 200));
-    let settings = Settings::tutorial(Stages::ALL);
-    let frame = raystep::render::render(&common::seed(300, 200), &settings, &|_| {});
+    let settings = Settings {
+        engine,
+        ..Settings::tutorial(Stages::ALL)
+    };
+    let frame = raystep::engine::render(&common::seed(300, 200), &settings, &|_| {});
+    assert_eq!(frame.engine, engine);
     let mut worst = (0.0f32, 0usize);
     for (i, (ours, theirs)) in frame.pixels.iter().zip(&reference).enumerate() {
         for (a, b) in ours.colour.iter().zip(theirs) {
@@ -31,7 +44,7 @@ fn every_stage_on_reproduces_the_tutorials_figure_1() {
     let (row, col) = (worst.1 / w, worst.1 % w);
     assert!(
         worst.0 <= TOLERANCE,
-        "pixel (row {row}, col {col}) differs by {}: ours {:?}, reference {:?}",
+        "{engine} engine: pixel (row {row}, col {col}) differs by {}: ours {:?}, reference {:?}",
         worst.0,
         frame.pixels[worst.1].colour,
         reference[worst.1]

@@ -1,0 +1,233 @@
+//! The fast engine (`--engine fast`): the book's tracer, four rays at a time.
+//!
+//! It is built on the book's [`Tracer`] and reads everything from it: the objects,
+//! the light, the rules, the BVH. What it adds never changes a pixel: rays traced
+//! four at a time in SIMD lanes ([`crate::packet`]), tile masks that skip objects
+//! a tile's primary rays cannot hit ([`TileMasks`]), and a packet walk of the
+//! BVH. `tests/speed.rs` holds it to the book's bits on every scene and setting.
+//! The book's files never import this one.
+//!
+//! What it does not take in packets (more than [`MAX_OBJECTS`] objects without
+//! a BVH), it traces with the book's own row loop, and says so in the frame
+//! ([`Frame::packets`] is then `off`).
+
+use rayon::prelude::*;
+
+use crate::accel::{Accel, TileMasks};
+use crate::aov::{Frame, Packets, PixelRecord, Rays};
+use crate::lanes::WIDTH;
+use crate::packet::{Packed, BATCH, MAX_OBJECTS};
+use crate::real::{Precision, Real};
+use crate::render::{book_row, Settings, Tracer};
+use crate::scene::Scene;
+use crate::stages::Engine;
+
+/// What the fast engine needs beside the book's tracer.
+pub struct Fast<T: Real = f64> {
+    /// The book's tracer, whose rules and objects every lane follows.
+    pub book: Tracer<T>,
+    /// Samples per pixel (a square number).
+    pub spp: u32,
+    /// For each tile of the image, the objects its primary rays can hit.
+    pub masks: TileMasks,
+    /// Trace four pixels at once (without a BVH only for up to [`MAX_OBJECTS`]
+    /// objects).
+    pub packets: bool,
+    /// The objects as the packet tracer reads them; empty without packets or with
+    /// a BVH.
+    pub packed: Vec<Packed<T>>,
+    /// Run the packet tracer's AVX build ([`Settings::avx`], and the processor
+    /// has AVX).
+    pub avx: bool,
+    /// The screen's `x` at each column, for the packet tracer's primary rays
+    /// (empty without packets).
+    pub columns: Vec<T>,
+}
+
+impl<T: Real> Fast<T> {
+    /// The fast engine for `scene` under `settings`, computing in `T`.
+    pub fn new(scene: &Scene, settings: &Settings) -> Fast<T> {
+        let book = Tracer::<T>::new(scene, settings);
+        assert!(
+            crate::scene_file::check_spp(settings.spp).is_ok(),
+            "spp {} is not a square from 1 to {}",
+            settings.spp,
+            crate::scene_file::MAX_SPP
+        );
+        // Packets search a short list by bit masks, a long one through the BVH.
+        let packets = book.bvh.is_some() || book.objects.len() <= MAX_OBJECTS;
+        let masks = match settings.accel {
+            Accel::Off => TileMasks::none(),
+            Accel::Auto | Accel::Bvh if packets => TileMasks::new(&book.camera, &book.objects),
+            Accel::Auto | Accel::Bvh => TileMasks::none(),
+        };
+        let packed = if packets && book.bvh.is_none() {
+            let objects = book.objects.iter();
+            objects.map(|o| Packed::new(o, &book.light)).collect()
+        } else {
+            Vec::new()
+        };
+        let columns = match packets {
+            true => (0..book.camera.width)
+                .map(|col| crate::lanes::components::<T>(book.camera.screen_point::<T>(0, col))[0])
+                .collect(),
+            false => Vec::new(),
+        };
+        Fast {
+            spp: settings.spp,
+            masks,
+            packets,
+            packed,
+            avx: packets && settings.avx && has_avx(),
+            columns,
+            book,
+        }
+    }
+
+    // ANCHOR: packet_row
+    /// The records of row `row`, four pixels at a time ([`Fast::pixel_packet`]),
+    /// into `line`, and the rays they took.
+    ///
+    /// The packet tracer is compiled twice: for any x86-64 processor (SSE2: two
+    /// float64 lanes to a register), and for one with AVX (four). Which one runs
+    /// is decided here, from what the processor says it has. Both compute every
+    /// lane with the same IEEE operations in the same order, so they give the same
+    /// bits; only the number of instructions differs.
+    pub fn packet_row(&self, row: u32, line: &mut [PixelRecord]) -> Rays {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx {
+            // SAFETY: `avx` is true only where the processor has AVX (`has_avx`).
+            #[allow(unsafe_code)]
+            return unsafe { self.packet_row_avx(row, line) };
+        }
+        self.packet_row_baseline(row, line)
+    }
+    // ANCHOR_END: packet_row
+
+    /// [`Fast::packet_row_in_lanes`] compiled for any processor of the target.
+    /// (A function of its own, so that `packet_row`'s frame holds only one of the
+    /// two builds' variables: in a debug build, where they are not packed, each
+    /// build's frame is about a megabyte.)
+    #[inline(never)]
+    fn packet_row_baseline(&self, row: u32, line: &mut [PixelRecord]) -> Rays {
+        self.packet_row_in_lanes(row, line)
+    }
+
+    /// [`Fast::packet_row_in_lanes`] compiled for AVX: everything it calls is
+    /// inlined into it, and so compiled for AVX too.
+    ///
+    /// # Safety
+    /// The processor must have AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[allow(unsafe_code)]
+    unsafe fn packet_row_avx(&self, row: u32, line: &mut [PixelRecord]) -> Rays {
+        self.packet_row_in_lanes(row, line)
+    }
+
+    /// The loop of [`Fast::packet_row`], for whichever build calls it.
+    #[inline(always)]
+    fn packet_row_in_lanes(&self, row: u32, line: &mut [PixelRecord]) -> Rays {
+        let mut rays = Rays::default();
+        // The primary rays of a few packets are made before any of them is traced.
+        // Each direction waits on a square root and a division; made one after the
+        // other they overlap, where made just before its packet each would hold up
+        // everything after it.
+        for (b, batch) in line.chunks_mut(WIDTH * BATCH).enumerate() {
+            let first = (b * WIDTH * BATCH) as u32;
+            let mut primary = [self.pixel_rays(row, first); BATCH];
+            for (k, packet) in primary.iter_mut().enumerate().skip(1) {
+                *packet = self.pixel_rays(row, first + (k * WIDTH) as u32);
+            }
+            for (k, pixels) in batch.chunks_mut(WIDTH).enumerate() {
+                rays += self.pixel_packet(row, first + (k * WIDTH) as u32, primary[k], pixels);
+            }
+        }
+        rays
+    }
+
+    /// The records of row `row` into `line` and the rays they took: in packets,
+    /// or by the book's row loop for what the packets do not take.
+    pub fn row(&self, row: u32, line: &mut [PixelRecord]) -> Rays {
+        if crate::interrupt::requested() {
+            return Rays::default(); // Ctrl-C: the rest is skipped, and the frame thrown away
+        }
+        match self.packets {
+            true => self.packet_row(row, line),
+            false => book_row(&self.book, self.spp, row, line),
+        }
+    }
+}
+
+/// Does this processor have AVX? (Asked once; false off x86-64.)
+pub fn has_avx() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Render `scene` under `settings` with the fast engine into `frame` (of the
+/// scene's size). `progress(1)` is called, from any thread, each time a row is
+/// finished.
+pub fn render_into(
+    scene: &Scene,
+    settings: &Settings,
+    frame: &mut Frame,
+    progress: &(dyn Fn(u64) + Sync),
+) {
+    match settings.precision {
+        Precision::F32 => render_in(
+            &Fast::<f32>::new(scene, settings),
+            scene,
+            settings,
+            frame,
+            progress,
+        ),
+        Precision::F64 => render_in(
+            &Fast::<f64>::new(scene, settings),
+            scene,
+            settings,
+            frame,
+            progress,
+        ),
+    }
+}
+
+/// [`render_into`] by `fast`: rows in parallel.
+fn render_in<T: Real>(
+    fast: &Fast<T>,
+    scene: &Scene,
+    settings: &Settings,
+    frame: &mut Frame,
+    progress: &(dyn Fn(u64) + Sync),
+) {
+    let width = scene.width as usize;
+    assert_eq!(frame.pixels.len(), width * scene.height as usize);
+    let rays = frame
+        .pixels
+        .par_chunks_mut(width)
+        .enumerate()
+        .map(|(row, line)| {
+            let rays = fast.row(row as u32, line);
+            progress(1);
+            rays
+        })
+        .reduce(Rays::default, |mut a, b| {
+            a += b;
+            a
+        });
+    frame.describe(scene, &fast.book, settings, rays);
+    frame.engine = Engine::Fast;
+    frame.packets = match (fast.packets, fast.avx) {
+        (false, _) => Packets::Off,
+        (true, false) => Packets::Baseline,
+        (true, true) => Packets::Avx,
+    };
+    // The fallback follows the book's paths; packets do not.
+    frame.book_paths = if fast.packets { 0 } else { rays.primary };
+}

@@ -1,0 +1,64 @@
+//! Several samples per pixel (`--spp`): rays through jittered points of a grid
+//! over the pixel, their colours averaged. They wrap the book's
+//! [`Tracer::pixel`](crate::render::Tracer::pixel) from outside: the pixel's own
+//! centre ray still gives the buffers, so they read the same whatever the sample
+//! count.
+
+use crate::real::Real;
+use crate::render::{Observer, Tracer};
+use crate::Vec3;
+
+// ANCHOR: samples
+/// The mean colour of `spp` stratified samples of pixel (`row`, `col`), each
+/// traced as the book traces a primary ray and told to `look`.
+pub fn mean<T: Real>(
+    tracer: &Tracer<T>,
+    row: u32,
+    col: u32,
+    spp: u32,
+    look: &mut impl Observer<T>,
+) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    for sample in 0..spp {
+        let (y, x) = stratified(row, col, sample, spp);
+        let ray = tracer.camera.ray_through::<T>(y, x);
+        look.primary(&ray);
+        sum += tracer.trace(ray, look).colour;
+    }
+    sum / f64::from(spp)
+}
+// ANCHOR_END: samples
+
+// ANCHOR: stratified
+/// Sample `sample` of `spp` (a square, n × n) in pixel (`row`, `col`): the centre
+/// of one cell of an n × n grid over the pixel, moved by a jitter within the cell.
+/// The jitter comes from a hash of the pixel and the sample, so every render gives
+/// the same samples. Returns the position in fractional rows and columns.
+pub fn stratified(row: u32, col: u32, sample: u32, spp: u32) -> (f64, f64) {
+    let n = spp.isqrt();
+    let (sy, sx) = (sample / n, sample % n);
+    let bits = splitmix64(u64::from(row) << 40 ^ u64::from(col) << 20 ^ u64::from(sample));
+    let (jy, jx) = (unit_interval(bits), unit_interval(splitmix64(bits)));
+    let n = f64::from(n);
+    (
+        f64::from(row) - 0.5 + (f64::from(sy) + jy) / n,
+        f64::from(col) - 0.5 + (f64::from(sx) + jx) / n,
+    )
+}
+// ANCHOR_END: stratified
+
+/// A number in [0, 1) from the top 53 bits of `bits`: every float64 of the form
+/// k / 2⁵³, equally likely.
+pub fn unit_interval(bits: u64) -> f64 {
+    (bits >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// SplitMix64 (Steele, Lea and Flood, 2014): a 64-bit hash whose outputs pass
+/// the usual statistical tests; one step of it turns a pixel's coordinates into
+/// its jitter.
+pub fn splitmix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
