@@ -227,7 +227,7 @@ fn explain_in<T: Real>(scene: &Scene, settings: &Settings, x: u32, y: u32) -> Ex
     told.unclipped = sum.to_f64().to_array();
     if settings.spp > 1 {
         let mut all = rays;
-        let mean = crate::samples::mean(&tracer, row, col, settings.spp, &mut all);
+        let mean = crate::render::samples_mean(&tracer, row, col, settings.spp, &mut all);
         told.samples = Some(Samples {
             spp: settings.spp,
             // As the record keeps it: in float32.

@@ -1,89 +1,28 @@
 //! The fast engine (`--engine fast`): the book's tracer, four rays at a time.
 //!
-//! It is built on the book's [`Tracer`] and reads everything from it: the objects,
+//! It is built on the book's [`Tracer`](crate::render::Tracer) and reads everything from it: the objects,
 //! the light, the rules, the BVH. What it adds never changes a pixel: rays traced
 //! four at a time in SIMD lanes ([`crate::packet`]), tile masks that skip objects
-//! a tile's primary rays cannot hit ([`TileMasks`]), and a packet walk of the
+//! a tile's primary rays cannot hit ([`TileMasks`](crate::accel::TileMasks)), and a packet walk of the
 //! BVH. `tests/speed.rs` holds it to the book's bits on every scene and setting.
 //! The book's files never import this one.
 //!
-//! What it does not take in packets (more than [`MAX_OBJECTS`] objects without
+//! What it does not take in packets (more than [`MAX_OBJECTS`](crate::packet::MAX_OBJECTS) objects without
 //! a BVH), it traces with the book's own row loop, and says so in the frame
 //! ([`Frame::packets`] is then `off`).
 
 use rayon::prelude::*;
 
-use crate::accel::{Accel, TileMasks};
 use crate::aov::{Frame, Packets, PixelRecord, Rays};
 use crate::lanes::WIDTH;
-use crate::packet::{Packed, BATCH, MAX_OBJECTS};
+pub use crate::packet::Fast;
+use crate::packet::BATCH;
 use crate::real::{Precision, Real};
-use crate::render::{book_row, Settings, Tracer};
+use crate::render::{book_row, Settings};
 use crate::scene::Scene;
 use crate::stages::Engine;
 
-/// What the fast engine needs beside the book's tracer.
-pub struct Fast<T: Real = f64> {
-    /// The book's tracer, whose rules and objects every lane follows.
-    pub book: Tracer<T>,
-    /// Samples per pixel (a square number).
-    pub spp: u32,
-    /// For each tile of the image, the objects its primary rays can hit.
-    pub masks: TileMasks,
-    /// Trace four pixels at once (without a BVH only for up to [`MAX_OBJECTS`]
-    /// objects).
-    pub packets: bool,
-    /// The objects as the packet tracer reads them; empty without packets or with
-    /// a BVH.
-    pub packed: Vec<Packed<T>>,
-    /// Run the packet tracer's AVX build ([`Settings::avx`], and the processor
-    /// has AVX).
-    pub avx: bool,
-    /// The screen's `x` at each column, for the packet tracer's primary rays
-    /// (empty without packets).
-    pub columns: Vec<T>,
-}
-
 impl<T: Real> Fast<T> {
-    /// The fast engine for `scene` under `settings`, computing in `T`.
-    pub fn new(scene: &Scene, settings: &Settings) -> Fast<T> {
-        let book = Tracer::<T>::new(scene, settings);
-        assert!(
-            crate::scene_file::check_spp(settings.spp).is_ok(),
-            "spp {} is not a square from 1 to {}",
-            settings.spp,
-            crate::scene_file::MAX_SPP
-        );
-        // Packets search a short list by bit masks, a long one through the BVH.
-        let packets = book.bvh.is_some() || book.objects.len() <= MAX_OBJECTS;
-        let masks = match settings.accel {
-            Accel::Off => TileMasks::none(),
-            Accel::Auto | Accel::Bvh if packets => TileMasks::new(&book.camera, &book.objects),
-            Accel::Auto | Accel::Bvh => TileMasks::none(),
-        };
-        let packed = if packets && book.bvh.is_none() {
-            let objects = book.objects.iter();
-            objects.map(|o| Packed::new(o, &book.light)).collect()
-        } else {
-            Vec::new()
-        };
-        let columns = match packets {
-            true => (0..book.camera.width)
-                .map(|col| crate::lanes::components::<T>(book.camera.screen_point::<T>(0, col))[0])
-                .collect(),
-            false => Vec::new(),
-        };
-        Fast {
-            spp: settings.spp,
-            masks,
-            packets,
-            packed,
-            avx: packets && settings.avx && has_avx(),
-            columns,
-            book,
-        }
-    }
-
     // ANCHOR: packet_row
     /// The records of row `row`, four pixels at a time ([`Fast::pixel_packet`]),
     /// into `line`, and the rays they took.
@@ -156,18 +95,6 @@ impl<T: Real> Fast<T> {
             true => self.packet_row(row, line),
             false => book_row(&self.book, self.spp, row, line),
         }
-    }
-}
-
-/// Does this processor have AVX? (Asked once; false off x86-64.)
-pub fn has_avx() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("avx")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
     }
 }
 

@@ -182,7 +182,7 @@ lanes!(f32, wide::f32x4, u32);
 /// The compiler turns each of these loops into SIMD instructions as wide as the
 /// function it lands in is compiled for: two SSE2 registers of two lanes on a plain
 /// x86-64 build, one AVX register of four inside
-/// [`Tracer::packet_row`](crate::render::Tracer::packet_row) on a processor that
+/// [`Fast::packet_row`](crate::fast::Fast::packet_row) on a processor that
 /// has AVX (chosen when the program runs), NEON pairs on ARM. The results are the
 /// same in every case: each lane is the IEEE operation, rounded once.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -48,16 +48,14 @@
 
 use std::borrow::Cow;
 
-use crate::accel::{EVERY, TILE};
-use crate::aov::PixelRecord;
-use crate::aov::Rays;
+use crate::accel::{Accel, TileMasks, EVERY, TILE};
+use crate::aov::{PixelRecord, Rays};
 use crate::bvh::PacketSearch;
-use crate::fast::Fast;
 use crate::lanes::{components, convert, each, powi, F64s, Lanes, ALL, V3, WIDTH};
 use crate::real::{Real, Vector};
-use crate::render::{direction_colour, HALF_STEP};
+use crate::render::{direction_colour, Settings, Tracer, HALF_STEP};
 use crate::samples::stratified;
-use crate::scene::{Light, Object, Shape};
+use crate::scene::{Light, Object, Scene, Shape};
 use crate::shade::blinn_phong::{whole_exponent, Viewer};
 use crate::shade::shadow::{Offset, AUTO_FACTOR};
 use crate::sphere::Method;
@@ -72,6 +70,81 @@ pub const MAX_OBJECTS: usize = 64;
 /// How many packets' primary rays [`Fast::packet_row`] makes before it traces
 /// them.
 pub const BATCH: usize = 16;
+
+/// What the fast engine needs beside the book's tracer.
+pub struct Fast<T: Real = f64> {
+    /// The book's tracer, whose rules and objects every lane follows.
+    pub book: Tracer<T>,
+    /// Samples per pixel (a square number).
+    pub spp: u32,
+    /// For each tile of the image, the objects its primary rays can hit.
+    pub masks: TileMasks,
+    /// Trace four pixels at once (without a BVH only for up to [`MAX_OBJECTS`]
+    /// objects).
+    pub packets: bool,
+    /// The objects as the packet tracer reads them; empty without packets or with
+    /// a BVH.
+    pub packed: Vec<Packed<T>>,
+    /// Run the packet tracer's AVX build ([`Settings::avx`], and the processor
+    /// has AVX).
+    pub avx: bool,
+    /// The screen's `x` at each column, for the packet tracer's primary rays
+    /// (empty without packets).
+    pub columns: Vec<T>,
+}
+
+impl<T: Real> Fast<T> {
+    /// The fast engine for `scene` under `settings`, computing in `T`.
+    pub fn new(scene: &Scene, settings: &Settings) -> Fast<T> {
+        let book = Tracer::<T>::new(scene, settings);
+        assert!(
+            crate::scene_file::check_spp(settings.spp).is_ok(),
+            "spp {} is not a square from 1 to {}",
+            settings.spp,
+            crate::scene_file::MAX_SPP
+        );
+        // Packets search a short list by bit masks, a long one through the BVH.
+        let packets = book.bvh.is_some() || book.objects.len() <= MAX_OBJECTS;
+        let masks = match settings.accel {
+            Accel::Off => TileMasks::none(),
+            Accel::Auto | Accel::Bvh if packets => TileMasks::new(&book.camera, &book.objects),
+            Accel::Auto | Accel::Bvh => TileMasks::none(),
+        };
+        let packed = if packets && book.bvh.is_none() {
+            let objects = book.objects.iter();
+            objects.map(|o| Packed::new(o, &book.light)).collect()
+        } else {
+            Vec::new()
+        };
+        let columns = match packets {
+            true => (0..book.camera.width)
+                .map(|col| crate::lanes::components::<T>(book.camera.screen_point::<T>(0, col))[0])
+                .collect(),
+            false => Vec::new(),
+        };
+        Fast {
+            spp: settings.spp,
+            masks,
+            packets,
+            packed,
+            avx: packets && settings.avx && has_avx(),
+            columns,
+            book,
+        }
+    }
+}
+
+/// Does this processor have AVX? (Asked once; false off x86-64.)
+pub fn has_avx() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
 
 /// An object as the packet tracer reads it: every number it needs, in precision
 /// `T` and in every lane, worked out once per render as the scalar tracer works

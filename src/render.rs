@@ -15,6 +15,7 @@ use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::ray::Ray;
 use crate::real::{Precision, Real, Vector};
+use crate::samples::stratified;
 use crate::scene::{nearest_hit, Hit, Light, Object, Role, Scene};
 use crate::shade::blinn_phong::{self, Terms, Viewer};
 use crate::shade::reflection;
@@ -487,7 +488,7 @@ pub fn book_row<T: Real>(tracer: &Tracer<T>, spp: u32, row: u32, line: &mut [Pix
         // Several samples: the colour is their mean; the buffers keep the centre
         // ray's first hit, so they read the same whatever the sample count.
         let colour = if spp > 1 && tracer.stages.intersection {
-            crate::samples::mean(tracer, row, col, spp, &mut path)
+            samples_mean(tracer, row, col, spp, &mut path)
         } else {
             centre.colour
         };
@@ -497,6 +498,27 @@ pub fn book_row<T: Real>(tracer: &Tracer<T>, spp: u32, row: u32, line: &mut [Pix
     rays
 }
 // ANCHOR_END: row
+
+// ANCHOR: samples
+/// The mean colour of `spp` stratified samples of pixel (`row`, `col`), each
+/// traced as the book traces a primary ray and told to `look`.
+pub fn samples_mean<T: Real>(
+    tracer: &Tracer<T>,
+    row: u32,
+    col: u32,
+    spp: u32,
+    look: &mut impl Observer<T>,
+) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    for sample in 0..spp {
+        let (y, x) = stratified(row, col, sample, spp);
+        let ray = tracer.camera.ray_through::<T>(y, x);
+        look.primary(&ray);
+        sum += tracer.trace(ray, look).colour;
+    }
+    sum / f64::from(spp)
+}
+// ANCHOR_END: samples
 
 impl Frame {
     /// Fill in what a frame says of how it was made, once `tracer` has traced the

@@ -1,33 +1,8 @@
-//! Several samples per pixel (`--spp`): rays through jittered points of a grid
-//! over the pixel, their colours averaged. They wrap the book's
-//! [`Tracer::pixel`](crate::render::Tracer::pixel) from outside: the pixel's own
-//! centre ray still gives the buffers, so they read the same whatever the sample
-//! count.
-
-use crate::real::Real;
-use crate::render::{Observer, Tracer};
-use crate::Vec3;
-
-// ANCHOR: samples
-/// The mean colour of `spp` stratified samples of pixel (`row`, `col`), each
-/// traced as the book traces a primary ray and told to `look`.
-pub fn mean<T: Real>(
-    tracer: &Tracer<T>,
-    row: u32,
-    col: u32,
-    spp: u32,
-    look: &mut impl Observer<T>,
-) -> Vec3 {
-    let mut sum = Vec3::ZERO;
-    for sample in 0..spp {
-        let (y, x) = stratified(row, col, sample, spp);
-        let ray = tracer.camera.ray_through::<T>(y, x);
-        look.primary(&ray);
-        sum += tracer.trace(ray, look).colour;
-    }
-    sum / f64::from(spp)
-}
-// ANCHOR_END: samples
+//! Where the samples of a pixel go (`--spp`): jittered points of a grid over the
+//! pixel, the same on every run. The book's row loop averages their colours
+//! ([`samples_mean`](crate::render::samples_mean)), outside
+//! [`Tracer::pixel`](crate::render::Tracer::pixel): the pixel's own centre ray
+//! still gives the buffers, so they read the same whatever the sample count.
 
 // ANCHOR: stratified
 /// Sample `sample` of `spp` (a square, n × n) in pixel (`row`, `col`): the centre
