@@ -18,7 +18,7 @@ fn main() {
 }
 
 fn seed() -> raystep::scene::Scene {
-    let mut scene = raystep::scene_file::seed();
+    let mut scene = raystep::io::scene_file::seed();
     (scene.width, scene.height) = (320, 240);
     scene
 }
@@ -96,7 +96,7 @@ fn floor(bencher: Bencher, kind: &str) {
         "fake" => seed(),
         _ => {
             let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/true-plane.toml");
-            let mut s = raystep::scene_file::load(path.as_ref()).unwrap();
+            let mut s = raystep::io::scene_file::load(path.as_ref()).unwrap();
             (s.width, s.height) = (320, 240);
             s
         }
@@ -143,7 +143,7 @@ fn intersect<T: Real>(bencher: Bencher, method: &str) {
 /// under a second).
 #[divan::bench(args = [1_000, 100_000, 1_000_000], sample_count = 5)]
 fn bvh_build(bencher: Bencher, count: usize) {
-    let scene = raystep::generate::scene(count, 1);
+    let scene = raystep::tools::generate::scene(count, 1);
     let objects: Vec<raystep::scene::Object> = scene.objects_in_play(Stages::ALL);
     let extent = raystep::render::extent(&scene);
     bencher.bench(|| raystep::bvh::Bvh::build(&objects, extent));
@@ -179,7 +179,7 @@ fn nearest_hit_bvh(bencher: Bencher, count: usize) {
 }
 
 fn spheres_and_rays(count: usize) -> (Vec<raystep::scene::Object>, Vec<Ray<f64>>) {
-    let mut scene = raystep::generate::scene(count, 1);
+    let mut scene = raystep::tools::generate::scene(count, 1);
     (scene.width, scene.height) = (64, 64);
     let camera = scene.camera();
     let rays = (0..64 * 64)

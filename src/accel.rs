@@ -4,25 +4,21 @@
 //! The book's [`nearest_hit`](crate::scene::nearest_hit) tests every object. Two
 //! things make that cheaper, and neither changes a pixel:
 //!
-//! - **Tiles of primary rays.** Every primary ray starts at the camera, so the rays
-//!   of a tile of 16 × 8 pixels lie inside a pyramid with its apex at the camera. An
-//!   object entirely outside that pyramid cannot be hit by any of them; each tile
-//!   keeps a bit mask of the objects that can ([`TileMasks`]). The test is made
-//!   with a margin larger than any rounding of the intersection test itself, so a
-//!   masked-out object is one the test would have missed anyway.
 //! - **A bounding volume hierarchy** ([`Bvh`](crate::bvh::Bvh)) over the spheres,
-//!   for scenes with many of them: a ray visits only the boxes it crosses.
+//!   for scenes with many of them: a ray visits only the boxes it crosses. The
+//!   book's tracer asks it through [`Tracer::nearest_hit`](crate::render::Tracer::nearest_hit)
+//!   and `in_shadow`, which name no structure in the listings.
+//! - **Tiles of primary rays**, in the fast engine (`src/fast/masks.rs`). Every
+//!   primary ray starts at the camera, so the rays of a tile of 16 × 8 pixels lie
+//!   inside a pyramid with its apex at the camera; an object entirely outside it
+//!   cannot be hit by any of them, and each tile keeps a bit mask of the objects
+//!   that can.
 //!
 //! `--accel off` turns both off (the plain loop, exactly the book's code);
 //! `--accel auto` (the default) uses the masks, and the BVH instead only when the
 //! scene has at least [`BVH_FROM`] spheres, below which plain iteration measured
 //! faster; `--accel bvh` forces the BVH. The textbook quadratic gets no BVH: its
 //! false hits far outside a sphere (chapter 9) would fall outside the boxes.
-
-use crate::camera::Camera;
-use crate::real::{Real, Vector};
-use crate::scene::{Object, Shape};
-use crate::Vec3;
 
 /// How the nearest hit is searched for (`--accel`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
@@ -49,7 +45,7 @@ impl std::fmt::Display for Accel {
 /// From this many spheres on, `--accel auto` builds a BVH. Measured at
 /// 1920 × 1080 with `raystep bench SCENE --no-yardstick --accel auto|bvh` on
 /// `raystep generate spheres --count N` scenes (N spheres and the floor), both
-/// four rays at a time ([`crate::packet`]): the plain loop with tile masks took
+/// four rays at a time ([`crate::fast::packet`]): the plain loop with tile masks took
 /// 0.135 s at 12 spheres against the BVH's 0.171 s, 0.219 s at 24 against
 /// 0.208 s, and 0.314 s at 48 against 0.266 s. (One ray at a time, the BVH paid
 /// from 12 spheres.) With the packets' float32 box test the plain loop still won
@@ -59,111 +55,3 @@ pub const BVH_FROM: usize = 24;
 
 /// Every object: the search mask that skips none.
 pub const EVERY: u64 = u64::MAX;
-
-/// Tile width and height, in pixels.
-pub const TILE: (u32, u32) = (16, 8);
-
-/// For each tile of the image, the objects its primary rays can hit: bit `i` set
-/// means object `i` must be tested. Only for scenes of at most 64 objects (larger
-/// ones use the BVH); [`TileMasks::mask`] gives every bit when there are none.
-#[derive(Clone, Debug, Default)]
-pub struct TileMasks {
-    columns: u32,
-    masks: Vec<u64>,
-}
-
-impl TileMasks {
-    /// No masks: every object is tested.
-    pub fn none() -> TileMasks {
-        TileMasks::default()
-    }
-
-    /// The masks of `camera`'s tiles for `objects`, computed in precision `T`'s
-    /// rounding (the margin grows with it).
-    pub fn new<T: Real>(camera: &Camera, objects: &[Object<T>]) -> TileMasks {
-        if objects.len() > 64 || camera.width < 2 || camera.height < 2 {
-            return TileMasks::none();
-        }
-        let columns = camera.width.div_ceil(TILE.0);
-        let rows = camera.height.div_ceil(TILE.1);
-        let origin = camera.position;
-        // Spheres as centre and an effective radius: the radius plus the widest
-        // false hit the rounding of either intersection method could report (the
-        // textbook quadratic's error in Δ grows with |O − C|²; 256·u of it covers
-        // both methods with room to spare).
-        let u = T::UNIT_ROUNDOFF.to_f64();
-        let spheres: Vec<Option<(Vec3, f64)>> = objects
-            .iter()
-            .map(|o| match o.shape {
-                Shape::Sphere(s) => {
-                    let (c, r) = (s.center.to_f64(), s.radius.to_f64());
-                    let reach = (c - origin).length() + r;
-                    Some((c, (r * r + 256.0 * u * reach * reach).sqrt() * (1.0 + 1e-9)))
-                }
-                Shape::Plane(_) => None,
-            })
-            .collect();
-        let mut masks = Vec::with_capacity((columns * rows) as usize);
-        for tile_row in 0..rows {
-            for tile_col in 0..columns {
-                // The tile's corners, half a pixel outside its outer pixels, so the
-                // jittered samples of --spp lie inside too.
-                let r0 = f64::from(tile_row * TILE.1) - 0.5;
-                let r1 = f64::from(((tile_row + 1) * TILE.1).min(camera.height) - 1) + 0.5;
-                let c0 = f64::from(tile_col * TILE.0) - 0.5;
-                let c1 = f64::from(((tile_col + 1) * TILE.0).min(camera.width) - 1) + 0.5;
-                let corners = [
-                    camera.screen_point_at::<f64>(r0, c0) - origin,
-                    camera.screen_point_at::<f64>(r0, c1) - origin,
-                    camera.screen_point_at::<f64>(r1, c1) - origin,
-                    camera.screen_point_at::<f64>(r1, c0) - origin,
-                ];
-                let edge = |i: usize| (corners[i], corners[(i + 1) % 4]);
-                // Edges less than 1e-6 apart in angle (a screen almost without
-                // height or width) give planes whose rounding the margin does not
-                // cover: such a tile gets no mask.
-                let wide = (0..4).all(|i| {
-                    let (a, b) = edge(i);
-                    a.cross(b).length() >= 1e-6 * a.length() * b.length()
-                });
-                if !wide {
-                    masks.push(EVERY);
-                    continue;
-                }
-                let inside = corners.iter().fold(Vec3::ZERO, |a, &c| a + c);
-                let planes: [Vec3; 4] = std::array::from_fn(|i| {
-                    let (a, b) = edge(i);
-                    let n = a.cross(b).normalize();
-                    if n.dot(inside) < 0.0 {
-                        -n
-                    } else {
-                        n
-                    }
-                });
-                // ANCHOR: tile_test
-                let mut mask = 0u64;
-                for (i, sphere) in spheres.iter().enumerate() {
-                    let candidate = match sphere {
-                        None => true,
-                        Some((c, reach)) => planes.iter().all(|n| n.dot(*c - origin) >= -reach),
-                    };
-                    if candidate {
-                        mask |= 1 << i;
-                    }
-                }
-                // ANCHOR_END: tile_test
-                masks.push(mask);
-            }
-        }
-        TileMasks { columns, masks }
-    }
-
-    /// The objects pixel (`row`, `col`)'s primary rays can hit.
-    #[inline]
-    pub fn mask(&self, row: u32, col: u32) -> u64 {
-        if self.masks.is_empty() {
-            return EVERY;
-        }
-        self.masks[((row / TILE.1) * self.columns + col / TILE.0) as usize]
-    }
-}

@@ -23,7 +23,6 @@
 //! float64 lanes, unless a ray starts too far out (`Bvh::enter_packet`). A node is
 //! 32 bytes, two to a cache line.
 
-use crate::lanes::{convert, F32s, F64s, Lanes, ALL, V3};
 use crate::ray::Ray;
 use crate::real::{Real, Vector};
 use crate::scene::{consider, Hit, Object, Role, Shape};
@@ -38,31 +37,31 @@ pub const LEAF: usize = 4;
 /// lines.
 #[derive(Clone, Copy, Debug)]
 #[repr(align(32))]
-struct Node {
-    min: glam::Vec3,
-    max: glam::Vec3,
+pub(crate) struct Node {
+    pub(crate) min: glam::Vec3,
+    pub(crate) max: glam::Vec3,
     /// Leaf: the first of its objects in `items`. Inner node: its second child
     /// (the first is the next node).
-    first: u32,
+    pub(crate) first: u32,
     /// Leaf: how many objects; inner node: 0.
-    count: u32,
+    pub(crate) count: u32,
 }
 
 /// The hierarchy over a scene's spheres.
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    nodes: Vec<Node>,
+    pub(crate) nodes: Vec<Node>,
     /// Object indices, leaf by leaf.
-    items: Vec<u32>,
+    pub(crate) items: Vec<u32>,
     /// The centre and radius of each sphere of `items`, in the same order, so
     /// that a leaf's spheres sit side by side in memory (for packets).
-    balls: Vec<[f64; 4]>,
+    pub(crate) balls: Vec<[f64; 4]>,
     /// Objects outside the tree, tested for every ray.
-    loose: Vec<u32>,
+    pub(crate) loose: Vec<u32>,
     /// Rays whose origin has no coordinate larger than this (in size) may test
     /// the boxes in float32: twice the largest coordinate of the root box (rounded
     /// down to float32).
-    fast_reach: f32,
+    pub(crate) fast_reach: f32,
 }
 
 /// How much farther than their float64 boxes the stored boxes reach, in units of
@@ -344,21 +343,8 @@ impl Bvh {
     }
 }
 
-/// What a search for objects along a packet's rays asks of them: the tree's walk
-/// ([`Bvh::search_packet`]), or the plain loop.
-pub trait PacketSearch {
-    /// The lanes still searching (none: the search stops).
-    fn active(&self) -> u32;
-    /// For each lane, the distance beyond which a box need not be entered.
-    fn limits(&self) -> F64s;
-    /// Test object `index` against the rays.
-    fn test(&mut self, index: usize);
-    /// Test object `index`, a sphere of centre `ball[0..3]` and radius `ball[3]`.
-    fn test_sphere(&mut self, index: usize, ball: &[f64; 4]);
-}
-
 /// The largest float32 not above `x`.
-fn below(x: f64) -> f32 {
+pub(crate) fn below(x: f64) -> f32 {
     let r = x as f32;
     if f64::from(r) <= x {
         r
@@ -373,200 +359,36 @@ fn below(x: f64) -> f32 {
 }
 
 /// The smallest float32 not below `x`.
-fn above(x: f64) -> f32 {
+pub(crate) fn above(x: f64) -> f32 {
     -below(-x)
 }
 
-impl Bvh {
-    // ANCHOR: enter_packet
-    /// [`Bvh::enter`] for four rays at once, in precision `L`: where each enters
-    /// the box of `node`, and the lanes that enter it before their limit.
-    ///
-    /// In float32 the origin, the direction, its reciprocal and each step of the
-    /// slab test round, and a box might seem missed by a ray that grazes it. The
-    /// stored boxes reach `32·u·R` past the float64 ones (u = 2⁻²⁴ is float32's
-    /// unit roundoff, R is [`Bvh::fast_reach`]), and [`Bvh::search_packet`] takes
-    /// this path only for rays whose origin coordinates are at most R in size.
-    /// Rounding the origin moves it by at most `u·R`; the slab value
-    /// `(b − o)·(1/d)` then comes out within four roundings of the exact one, an
-    /// error of at most `4u·|b − o| ≤ 4u·1.5R` along the axis (faces lie within
-    /// R/2). Both together are less than the `32u·R` the faces were moved out, so
-    /// a lane that enters the exact box also enters the stored one, at a smaller
-    /// `t`, and its limit is rounded up ([`up_to_f32`]). (Scene files keep every
-    /// coordinate within 10¹⁵, far inside float32's range, and R above its
-    /// subnormals, or the tree is walked in float64.) The unit test
-    /// `a_float32_box_test_enters_every_box_the_exact_ray_enters` fails with
-    /// faces moved out by `2u·R`.
-    ///
-    /// The minima and maxima need not care for NaNs: one comes only from `0·∞`,
-    /// an origin exactly on a stored face with the direction parallel to it, and
-    /// such a ray passes `32u·R` outside the exact box, which any answer skips
-    /// rightly or visits in vain.
-    #[inline(always)]
-    fn enter_packet<L: Real>(
-        node: &Node,
-        origin: &V3<L>,
-        inverse: &V3<L>,
-        limit: L::Lanes,
-    ) -> (L::Lanes, u32) {
-        let slab = |min: f32, max: f32, o: L::Lanes, inv: L::Lanes| {
-            let face = |b: f32| L::Lanes::splat(L::of(f64::from(b)));
-            let t1 = (face(min) - o) * inv;
-            let t2 = (face(max) - o) * inv;
-            (t1.fast_min(t2), t1.fast_max(t2))
-        };
-        let (nx, fx) = slab(node.min.x, node.max.x, origin.x, inverse.x);
-        let (ny, fy) = slab(node.min.y, node.max.y, origin.y, inverse.y);
-        let (nz, fz) = slab(node.min.z, node.max.z, origin.z, inverse.z);
-        let near = nx
-            .fast_max(ny)
-            .fast_max(nz)
-            .fast_max(L::Lanes::splat(L::of(0.0)));
-        let far = fx.fast_min(fy).fast_min(fz);
-        (near, (far.ge(near) & limit.ge(near)).bits())
+/// A sphere of centre (`x`, `y`, `z`) and radius `r` (for the tests here and of
+/// the packet walk).
+#[cfg(test)]
+pub(crate) fn test_ball(x: f64, y: f64, z: f64, r: f64) -> Object {
+    Object {
+        shape: Shape::Sphere(crate::sphere::Sphere {
+            center: Vec3::new(x, y, z),
+            radius: r,
+        }),
+        material: crate::scene::Material {
+            ambient: Vec3::ZERO,
+            diffuse: Vec3::ONE,
+            specular: Vec3::ZERO,
+            shininess: 100.0,
+            reflection: 0.0,
+        },
+        role: Role::Sphere,
     }
-    // ANCHOR_END: enter_packet
-
-    // ANCHOR: search_packet
-    /// Walk the tree with four rays from `origin` along `direction`: every object
-    /// outside the tree, then every object of every leaf whose box some lane still
-    /// searching enters before its limit. A lane's result is the one-ray walk's,
-    /// because a lane skips only boxes that cannot hold a hit as near as its
-    /// limit; objects it did not need are tested too, and cannot come nearer. The
-    /// boxes are tested in float32 when every origin lies within
-    /// `Bvh::fast_reach` (see `Bvh::enter_packet`), in float64 otherwise.
-    #[inline(always)]
-    pub fn search_packet<T: Real, S: PacketSearch>(
-        &self,
-        origin: &V3<T>,
-        direction: &V3<T>,
-        search: &mut S,
-    ) {
-        for &i in &self.loose {
-            search.test(i as usize);
-        }
-        if self.nodes.is_empty() {
-            return;
-        }
-        let reach = T::Lanes::splat(T::of(f64::from(self.fast_reach)));
-        if reach.ge(origin.max_abs()).bits() == ALL {
-            let (o, d) = (origin.convert::<f32>(), direction.convert::<f32>());
-            self.walk(&o, &d, search, up_to_f32);
-        } else {
-            let (o, d) = (origin.convert::<f64>(), direction.convert::<f64>());
-            self.walk(&o, &d, search, |l| l);
-        }
-    }
-    // ANCHOR_END: search_packet
-
-    /// The walk of [`Bvh::search_packet`], testing boxes in precision `L`, with
-    /// the search's limits converted by `limits_in`.
-    #[inline(always)]
-    fn walk<L: Real, S: PacketSearch>(
-        &self,
-        origin: &V3<L>,
-        direction: &V3<L>,
-        search: &mut S,
-        limits_in: impl Fn(F64s) -> L::Lanes,
-    ) {
-        let one = L::Lanes::splat(L::of(1.0));
-        let d = direction;
-        let inverse = &V3::new(one / d.x, one / d.y, one / d.z);
-        // The lanes still searching and their limits change only when a leaf's
-        // objects are tested.
-        let limits = |search: &S| (search.active(), limits_in(search.limits()));
-        let enters = |node: usize, (active, limit): (u32, L::Lanes)| {
-            let (near, bits) = Self::enter_packet(&self.nodes[node], origin, inverse, limit);
-            (near, bits & active)
-        };
-        let mut now = limits(search);
-        if enters(0, now).1 == 0 {
-            return;
-        }
-        let mut stack = [0u32; 64];
-        let mut depth = 0;
-        let mut node = 0usize;
-        loop {
-            let n = self.nodes[node];
-            if n.count > 0 {
-                for k in n.first as usize..(n.first + n.count) as usize {
-                    search.test_sphere(self.items[k] as usize, &self.balls[k]);
-                }
-                now = limits(search);
-                if now.0 == 0 {
-                    return; // no lane is searching any more (all blocked)
-                }
-            } else {
-                let (a, b) = (node + 1, n.first as usize);
-                let (ta, ma) = enters(a, now);
-                let (tb, mb) = enters(b, now);
-                if ma != 0 && mb != 0 {
-                    // Nearer first for the lowest lane that enters both (the
-                    // first child first if no lane enters both).
-                    let both = ma & mb;
-                    let lane = both.trailing_zeros() as usize;
-                    let a_first = both == 0 || ta.to_array()[lane] <= tb.to_array()[lane];
-                    let (near, far) = if a_first { (a, b) } else { (b, a) };
-                    stack[depth] = far as u32;
-                    depth += 1;
-                    node = near;
-                    continue;
-                }
-                if ma != 0 || mb != 0 {
-                    node = if ma != 0 { a } else { b };
-                    continue;
-                }
-            }
-            // Next from the stack, skipping boxes no lane still needs.
-            loop {
-                if depth == 0 {
-                    return;
-                }
-                depth -= 1;
-                let candidate = stack[depth] as usize;
-                if enters(candidate, now).1 != 0 {
-                    node = candidate;
-                    break;
-                }
-            }
-        }
-    }
-}
-
-/// Distances in float32, each at least the float64 one: rounded to nearest, then
-/// multiplied by 1 + 2⁻²³, which lifts a normal float32 `r` to at least the next
-/// one up (`r·2⁻²³` is at least its spacing), so `x` below `r`'s upper neighbour
-/// is covered; the smallest subnormal added does the same for subnormals, which
-/// the product does not lift. Infinity stays infinite.
-fn up_to_f32(l: F64s) -> F32s {
-    let up = F32s::splat(1.0 + f32::EPSILON);
-    let tiny = F32s::splat(f32::from_bits(1));
-    convert::<f64, f32>(l) * up + tiny
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lanes::WIDTH;
-    use crate::scene::{Material, Object};
-    use crate::sphere::Sphere;
+    use crate::scene::Object;
 
-    fn ball(x: f64, y: f64, z: f64, r: f64) -> Object {
-        Object {
-            shape: Shape::Sphere(Sphere {
-                center: Vec3::new(x, y, z),
-                radius: r,
-            }),
-            material: Material {
-                ambient: Vec3::ZERO,
-                diffuse: Vec3::ONE,
-                specular: Vec3::ZERO,
-                shininess: 100.0,
-                reflection: 0.0,
-            },
-            role: Role::Sphere,
-        }
-    }
+    use super::test_ball as ball;
 
     #[test]
     fn every_sphere_sits_in_one_leaf_and_the_depth_fits_the_stack() {
@@ -629,96 +451,6 @@ mod tests {
             // Equal where x is a float32, else neighbours: no float32 between.
             let middle = ((f64::from(lo) + f64::from(hi)) / 2.0) as f32;
             assert!(middle == lo || middle == hi, "{x}: {lo} {hi}");
-        }
-        // A limit never shrinks in float32, subnormals and the largest included.
-        let limits = [
-            1.4 * 2f64.powi(-149),
-            1e-40,
-            0.1,
-            1.0 + 1e-12,
-            3e38,
-            f64::INFINITY,
-        ];
-        for chunk in limits.chunks(WIDTH) {
-            let mut lanes = [0.0; WIDTH];
-            lanes[..chunk.len()].copy_from_slice(chunk);
-            let up = up_to_f32(F64s::from_array(lanes)).to_array();
-            for (x, r) in lanes.iter().zip(up) {
-                assert!(f64::from(r) >= *x, "{x} became {r}");
-            }
-        }
-    }
-
-    /// The float64 slab test of [`Bvh::enter`] on the box `min`..`max`.
-    fn enters_exact(min: Vec3, max: Vec3, origin: Vec3, direction: Vec3) -> Option<f64> {
-        let inverse = Vec3::ONE / direction;
-        let (t1, t2) = ((min - origin) * inverse, (max - origin) * inverse);
-        let near = t1.min(t2).max_element().max(0.0);
-        let far = t1.max(t2).min_element();
-        (near <= far).then_some(near)
-    }
-
-    proptest::proptest! {
-        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(
-            std::env::var("RAYSTEP_PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(4000)
-        ))]
-
-        /// The float32 box test of the packet walk never skips a sphere's box that
-        /// the float64 test enters, for rays that graze the box's faces, edges and
-        /// corners (some along a face, with a direction component of zero), from
-        /// anywhere within the fast reach, at scales from 10⁻¹⁰ to 10¹⁴; nor does the
-        /// packet walk's float64 test of the stored boxes.
-        #[test]
-        fn a_float32_box_test_enters_every_box_the_exact_ray_enters(
-            scale in -10.0f64..14.0,
-            far in 0.0f64..1.0,
-            centre in proptest::array::uniform3(-1.0f64..1.0),
-            size in 0.001f64..1.0,
-            from in proptest::array::uniform3(-1.0f64..1.0),
-            on in proptest::array::uniform3(0.0f64..1.0),
-            face in 0usize..6,
-            bounds in 1usize..=3,
-            parallel in proptest::bool::ANY,
-        ) {
-            let s = 10f64.powf(scale);
-            let c = Vec3::from(centre) * s * 10f64.powf(far);
-            let r = s * size;
-            let objects = [ball(c.x, c.y, c.z, r)];
-            let bvh = Bvh::build(&objects, c.abs().max_element() + r);
-            // A point on the sphere's tight box: on a face, an edge or a corner.
-            let (min, max) = (c - r, c + r);
-            let mut p = min + (max - min) * Vec3::from(on);
-            let axis = face % 3;
-            for k in 0..bounds {
-                let a = (axis + k) % 3;
-                p[a] = if (face + k) % 2 == 0 { min[a] } else { max[a] };
-            }
-            let mut origin = Vec3::from(from) * f64::from(bvh.fast_reach);
-            if parallel {
-                // Along the face: a direction component of exactly zero.
-                origin[axis] = p[axis];
-            }
-            let direction = (p - origin).normalize();
-            proptest::prop_assume!(direction.is_finite());
-            let Some(t) = enters_exact(min, max, origin, direction) else {
-                return Ok(()); // rounded out of the box in float64: nothing to check
-            };
-            let lanes = |v: Vec3| V3::<f64>::splat(v).convert::<f32>();
-            // As the walk makes them: the reciprocal of the float32 direction.
-            let (o, d) = (lanes(origin), lanes(direction));
-            let one = F32s::splat(1.0);
-            let inverse = V3::new(one / d.x, one / d.y, one / d.z);
-            // The tightest limit: the exact ray's own entry distance.
-            let limit = up_to_f32(F64s::splat(t));
-            let (near, bits) = Bvh::enter_packet(&bvh.nodes[0], &o, &inverse, limit);
-            proptest::prop_assert_eq!(bits, ALL, "t = {}", t);
-            proptest::prop_assert!(f64::from(near.to_array()[0]) <= t);
-            // The float64 lanes, which rays from farther away take, too.
-            let wide = |v: Vec3| V3::<f64>::splat(v);
-            let (o, inverse) = (wide(origin), wide(Vec3::ONE / direction));
-            let (near, bits) = Bvh::enter_packet(&bvh.nodes[0], &o, &inverse, F64s::splat(t));
-            proptest::prop_assert_eq!(bits, ALL, "t = {}", t);
-            proptest::prop_assert!(near.to_array()[0] <= t);
         }
     }
 }

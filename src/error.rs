@@ -57,3 +57,13 @@ impl fmt::Display for Error {
 }
 
 impl std::error::Error for Error {}
+
+/// `Err(Error::Interrupted)` once an interrupt has been asked for
+/// ([`crate::interrupt`]).
+pub fn check_interrupt() -> Result<(), Error> {
+    if crate::interrupt::requested() {
+        Err(Error::Interrupted)
+    } else {
+        Ok(())
+    }
+}

@@ -3,13 +3,11 @@
 //!
 //! The first signal only raises a flag: the pixel loop stops taking new rows, and
 //! the files of the interrupted render are never renamed into place (see
-//! [`crate::output::Pending`]). A second signal ends the process at once, for the
+//! [`crate::io::output::Pending`]). A second signal ends the process at once, for the
 //! case where something does not stop; the temporary files it leaves are removed
 //! by the next run that writes to the same folder.
 
 use std::sync::atomic::{AtomicBool, Ordering};
-
-use crate::error::Error;
 
 static REQUESTED: AtomicBool = AtomicBool::new(false);
 
@@ -30,13 +28,4 @@ pub fn install() {
 /// Whether an interrupt has been asked for.
 pub fn requested() -> bool {
     REQUESTED.load(Ordering::Relaxed)
-}
-
-/// `Err(Error::Interrupted)` once an interrupt has been asked for.
-pub fn check() -> Result<(), Error> {
-    if requested() {
-        Err(Error::Interrupted)
-    } else {
-        Ok(())
-    }
 }

@@ -17,7 +17,7 @@
 //! The modules below are listed in the order the book introduces them, so this
 //! file reads as its table of contents.
 // One place only, with its reason: the call of the packet loop's AVX build once
-// the processor is found to have AVX (`Fast::packet_row`, fast.rs).
+// the processor is found to have AVX (`Fast::packet_row`, fast/mod.rs).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -27,8 +27,7 @@ pub use glam::DVec3 as Vec3;
 // Chapter 1: setting the scene.
 pub mod camera;
 pub mod scene;
-pub mod scene_file;
-// Chapter 2: rays.
+// Chapter 2: rays, and the numbers they are computed in.
 pub mod ray;
 pub mod real;
 // Chapter 3: intersection.
@@ -37,30 +36,21 @@ pub mod sphere;
 pub mod shade;
 // Chapter 7: the plane.
 pub mod plane;
-// The switches, the pixel loop and what it writes.
+// The switches, the book's tracer (the pixel loop) and the buffers it fills.
 pub mod aov;
-pub mod contact;
-pub mod output;
-pub mod page;
 pub mod render;
-pub mod samples;
 pub mod stages;
-// Speed: skipping tests that cannot succeed, and four rays at once.
+// Chapter 10: samples, and finding the nearest hit without testing every object.
 pub mod accel;
 pub mod bvh;
+pub mod samples;
+
+// What serves the book, each part depending on the book and never the other way
+// round: the fast engine, the one place that picks an engine, files in and out,
+// the commands, and the errors and Ctrl-C they share.
 pub mod engine;
-pub mod fast;
-pub mod lanes;
-pub mod packet;
-// The command line, its errors, and the tools around the renderer.
-pub mod accuracy;
-pub mod bench;
-pub mod chart;
-pub mod cli;
-pub mod compare;
 pub mod error;
-pub mod explain;
-pub mod figures;
-pub mod generate;
+pub mod fast;
 pub mod interrupt;
-pub mod yardstick;
+pub mod io;
+pub mod tools;

@@ -5,7 +5,7 @@
 use std::process::ExitCode;
 
 use clap::Parser;
-use raystep::cli::{run, Cli};
+use raystep::tools::cli::{run, Cli};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();

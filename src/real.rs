@@ -26,8 +26,6 @@ pub trait Real:
 {
     /// The 3-vector of this precision.
     type Vec3: Vector<Self>;
-    /// Four numbers of this precision in SIMD lanes, for the packet tracer.
-    type Lanes: crate::lanes::Lanes<Self>;
     /// The unit roundoff u: every basic operation is exact up to a factor (1 ± u).
     const UNIT_ROUNDOFF: Self;
     /// `f32` or `f64`.
@@ -94,10 +92,9 @@ pub trait Vector<T>:
 }
 
 macro_rules! real {
-    ($t:ty, $v:ty, $l:ty, $name:literal) => {
+    ($t:ty, $v:ty, $name:literal) => {
         impl Real for $t {
             type Vec3 = $v;
-            type Lanes = $l;
             const UNIT_ROUNDOFF: $t = <$t>::EPSILON / 2.0;
             const NAME: &'static str = $name;
             fn of(x: f64) -> $t {
@@ -173,8 +170,8 @@ macro_rules! real {
     };
 }
 
-real!(f32, glam::Vec3, wide::f32x4, "f32");
-real!(f64, glam::DVec3, crate::lanes::F64x4, "f64");
+real!(f32, glam::Vec3, "f32");
+real!(f64, glam::DVec3, "f64");
 
 /// Which [`Real`] a render computes in (`--precision`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]

@@ -37,3 +37,24 @@ pub fn splitmix64(x: u64) -> u64 {
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
 }
+
+/// Most samples per pixel (`--spp`): 32 × 32.
+pub const MAX_SPP: u32 = 1024;
+
+/// Refuse a sample count that is not a square from 1 to [`MAX_SPP`] (the samples
+/// of a pixel form an n × n grid of strata).
+pub fn check_spp(spp: u32) -> Result<(), String> {
+    let n = spp.isqrt();
+    if !(1..=MAX_SPP).contains(&spp) {
+        Err(format!("--spp {spp}: must be from 1 to {MAX_SPP}"))
+    } else if n * n != spp {
+        Err(format!(
+            "--spp {spp}: must be a square number (1, 4, 9, 16, …), so that the samples \
+             form an n × n grid over the pixel; the nearest are {} and {}",
+            n * n,
+            (n + 1) * (n + 1)
+        ))
+    } else {
+        Ok(())
+    }
+}

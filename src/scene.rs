@@ -10,6 +10,10 @@ use crate::sphere::{Method, Sphere};
 use crate::stages::Stages;
 use crate::Vec3;
 
+/// Largest magnitude accepted for any number in a scene: squares of coordinates
+/// stay far inside float32's and float64's range.
+pub const MAX_MAGNITUDE: f64 = 1e15;
+
 /// How a surface answers light (the Blinn-Phong coefficients and the mirror weight).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material<T: Real = f64> {

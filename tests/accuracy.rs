@@ -6,7 +6,6 @@ mod common;
 
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
-use raystep::accuracy::{case, measure, outside_exactly, Measure, CASES};
 use raystep::ray::Ray;
 use raystep::real::{Precision, Real, Vector};
 use raystep::render::{render, Settings};
@@ -14,6 +13,7 @@ use raystep::scene::{Material, Object, Role, Shape};
 use raystep::shade::shadow::{step_off, Offset};
 use raystep::sphere::{Method, Sphere};
 use raystep::stages::Stages;
+use raystep::tools::accuracy::{case, measure, outside_exactly, Measure, CASES};
 use raystep::Vec3;
 
 use Method::{Naive, Stable};
@@ -388,7 +388,7 @@ proptest! {
             toml += &format!("[[sphere]]\ncenter = [{}, {}, {}]\nradius = {}\n", c.x, c.y, c.z, r * s);
         }
         toml += &format!("[[plane]]\npoint = [0, {}, 0]\nnormal = [0, 1, 0]\n", -s);
-        let mut scene = raystep::scene_file::parse(&toml, "generated").unwrap();
+        let mut scene = raystep::io::scene_file::parse(&toml, "generated").unwrap();
         (scene.camera, scene.light.position) = (cam, light);
         let settings = Settings {
             precision: if f32_precision { F32 } else { F64 },
@@ -441,7 +441,7 @@ fn tangent_rays_and_a_light_inside_a_sphere_give_finite_pixels() {
     let toml = "[image]\nwidth = 3\nheight = 3\n[camera]\nposition = [0, 0, 1]\n\
                 [light]\nposition = [5, 5, 5]\n[[sphere]]\ncenter = [1, 0, -2]\nradius = 1\n\
                 [[plane]]\npoint = [0, -1, 0]\nnormal = [0, 1, 0]\n";
-    let mut scene = raystep::scene_file::parse(toml, "tangent").unwrap();
+    let mut scene = raystep::io::scene_file::parse(toml, "tangent").unwrap();
     // At the sphere's centre: the loader refuses that, a scene built in code need not.
     scene.light.position = raystep::Vec3::new(1.0, 0.0, -2.0);
     for precision in [F32, F64] {
@@ -465,7 +465,7 @@ fn a_too_small_height_above_a_plane_is_not_a_nan() {
     // rays; the plane must count as missed, not give an infinite hit point.
     let toml = "[image]\nwidth = 8\nheight = 6\n[camera]\nposition = [0, 1e-310, 1]\n\
                 [light]\nposition = [0, 5, 0]\n[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\n";
-    let scene = raystep::scene_file::parse(toml, "low").unwrap();
+    let scene = raystep::io::scene_file::parse(toml, "low").unwrap();
     for precision in [F32, F64] {
         let settings = Settings {
             precision,

@@ -3,8 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use raystep::compare::{compare, Difference};
-use raystep::figures::{check_all, render_command, FIGURES};
+use raystep::tools::cli::render_command;
+use raystep::tools::compare::{compare, Difference};
+use raystep::tools::figures::{check_all, FIGURES};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -192,7 +193,7 @@ fn every_figure_shows_the_command_that_made_it() {
 
 #[test]
 fn the_committed_figures_are_what_the_code_renders_now() {
-    let problems = check_all(&root(), &root().join("chapters/img")).unwrap();
+    let problems = check_all(&root(), &root().join("chapters/img"), &render_command).unwrap();
     assert!(
         problems.is_empty(),
         "run `cargo run --release -- figures` and look at the images:\n{}",
@@ -317,16 +318,16 @@ fn the_numbers_the_chapters_quote_are_measured_again() {
 
 #[test]
 fn every_accuracy_row_a_chapter_quotes_is_what_raystep_accuracy_prints_now() {
-    let rows: Vec<String> = raystep::accuracy::measure_all()
+    let rows: Vec<String> = raystep::tools::accuracy::measure_all()
         .iter()
-        .map(raystep::accuracy::table_row)
+        .map(raystep::tools::accuracy::table_row)
         .collect();
-    let header = raystep::accuracy::table_header();
+    let header = raystep::tools::accuracy::table_header();
     let mut quoted = 0;
     for (name, text) in chapters() {
         for line in text.lines() {
             let first = line.split_whitespace().next().unwrap_or("");
-            if raystep::accuracy::CASES
+            if raystep::tools::accuracy::CASES
                 .iter()
                 .any(|(case, _)| *case == first)
                 && line.contains("  f")
@@ -347,8 +348,11 @@ fn every_accuracy_row_a_chapter_quotes_is_what_raystep_accuracy_prints_now() {
 
 #[test]
 fn chapter_1_quotes_what_check_prints() {
-    let scene = raystep::scene_file::load(&root().join("scenes/seed.toml")).unwrap();
-    assert_quotes("01", &raystep::cli::describe(&scene, "scenes/seed.toml"));
+    let scene = raystep::io::scene_file::load(&root().join("scenes/seed.toml")).unwrap();
+    assert_quotes(
+        "01",
+        &raystep::tools::cli::describe(&scene, "scenes/seed.toml"),
+    );
 }
 
 #[test]
@@ -450,9 +454,9 @@ fn chapter_11_tells_the_story_explain_tells_now() {
     let fifth = snap.lines().nth(4).unwrap();
     assert!(fifth.starts_with("pixel x = 74, y = 125"), "{fifth}");
     assert!(text.contains("explain --pixel 74,125"));
-    let scene = raystep::scene_file::seed();
+    let scene = raystep::io::scene_file::seed();
     let settings = raystep::render::Settings::from(raystep::stages::Stages::ALL);
-    let story = raystep::explain::explain(&scene, &settings, 74, 125);
+    let story = raystep::tools::explain::explain(&scene, &settings, 74, 125);
     assert!(snap.contains(story.to_string().trim_end()));
     // What the chapter reads off the story.
     for quoted in ["at t = 4.65", "12.17 away", "at 2.78", "1.7e-11"] {

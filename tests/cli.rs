@@ -317,7 +317,7 @@ fn generate_writes_a_scene_that_loads_and_refuses_a_count_of_zero() {
         &["generate", "spheres", "--count", "25", "--seed", "4"],
     );
     assert!(out.status.success(), "{}", text(&out.stderr));
-    let scene = raystep::scene_file::parse(&text(&out.stdout), "generated").unwrap();
+    let scene = raystep::io::scene_file::parse(&text(&out.stdout), "generated").unwrap();
     assert_eq!(scene.objects.len(), 26, "25 spheres and the floor");
     let again = raystep(
         dir.path(),

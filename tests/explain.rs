@@ -5,11 +5,11 @@
 mod common;
 
 use raystep::aov::{Frame, PixelRecord, NO_OBJECT};
-use raystep::explain::{explain, Explanation};
 use raystep::real::Precision;
 use raystep::render::{render, Settings};
 use raystep::scene::Scene;
 use raystep::stages::{Stage, Stages};
+use raystep::tools::explain::{explain, Explanation};
 
 /// Check that the story of every pixel gives the numbers the render stored.
 fn agrees_everywhere(scene: &Scene, settings: &Settings) {
@@ -94,7 +94,7 @@ fn the_story_of_every_pixel_ends_where_the_render_did() {
     agrees_everywhere(&scene, &Settings::from(without_shadow));
     for name in ["mirrors", "true-plane", "highlights"] {
         let path = format!("{}/scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"));
-        let mut scene = raystep::scene_file::load(path.as_ref()).unwrap();
+        let mut scene = raystep::io::scene_file::load(path.as_ref()).unwrap();
         (scene.width, scene.height) = (50, 35);
         agrees_everywhere(&scene, &Settings::from(Stages::ALL));
     }

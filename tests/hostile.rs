@@ -222,7 +222,7 @@ fn every_bad_scene_file_ends_in_its_message_and_writes_nothing() {
         if expected.exit == 0 {
             // What is accepted renders to finite colours in [0, 1].
             let exr = dir.path().join("out/buffers.exr");
-            let (_, _, pixels) = raystep::compare::read_beauty(&exr).unwrap();
+            let (_, _, pixels) = raystep::tools::compare::read_beauty(&exr).unwrap();
             assert!(
                 pixels.iter().flatten().all(|c| (0.0..=1.0).contains(c)),
                 "{name}: a colour outside [0, 1]"
@@ -477,11 +477,11 @@ fn a_killed_render_leaves_whole_files_and_the_next_run_clears_its_temporaries() 
 
 #[test]
 fn help_states_every_limit_with_the_numbers_the_code_uses() {
-    use raystep::scene_file::*;
+    use raystep::io::scene_file::*;
     let help = raystep(Path::new("."), &["--help"]);
     let help = String::from_utf8_lossy(&help.stdout);
     assert!(
-        help.contains(raystep::cli::LIMITS),
+        help.contains(raystep::tools::cli::LIMITS),
         "--help ends with the limits"
     );
     let (w, h) = (7680u64, 4320u64);
@@ -498,7 +498,7 @@ fn help_states_every_limit_with_the_numbers_the_code_uses() {
         format!("at most {} MiB", MAX_FILE_BYTES / (1024 * 1024)),
     ] {
         assert!(
-            raystep::cli::LIMITS.contains(&stated),
+            raystep::tools::cli::LIMITS.contains(&stated),
             "{stated:?} in the limits"
         );
     }

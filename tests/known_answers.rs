@@ -4,14 +4,14 @@
 
 mod common;
 
-use raystep::accuracy::surface_distance;
-use raystep::output::{exr_bytes, png_bytes};
+use raystep::io::output::{exr_bytes, png_bytes};
 use raystep::ray::Ray;
 use raystep::render::Settings;
 use raystep::render::Tracer;
 use raystep::shade::reflection::reflect;
 use raystep::shade::shadow::{step_off, Offset};
 use raystep::stages::{Stage, Stages};
+use raystep::tools::accuracy::surface_distance;
 use raystep::Vec3;
 
 /// One sphere straight ahead of the camera, light at the camera.
@@ -87,7 +87,7 @@ fn lit_head_on_the_centre_pixel_is_ambient_plus_diffuse_plus_specular() {
 fn the_exr_holds_the_exact_depth_of_a_pixel() {
     let frame = common::render(&common::scene(ONE_SPHERE), Stages::ALL);
     let dir = tempfile::tempdir().unwrap();
-    raystep::output::write_frame(&frame, dir.path()).unwrap();
+    raystep::io::output::write_frame(&frame, dir.path()).unwrap();
     let image =
         exr::prelude::read_all_flat_layers_from_file(dir.path().join("buffers.exr")).unwrap();
     let layer = &image.layer_data[0];
@@ -281,7 +281,7 @@ fn switched_off_stages_give_what_other_settings_give() {
 
     // On a scene with no [[plane]], the plane stage changes nothing.
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/shadow.toml");
-    let no_planes = raystep::scene_file::load(path.as_ref()).unwrap();
+    let no_planes = raystep::io::scene_file::load(path.as_ref()).unwrap();
     assert_eq!(
         common::render(&no_planes, Stages::up_to(Stage::Plane)).pixels,
         common::render(&no_planes, Stages::up_to(Stage::Reflection)).pixels
@@ -341,11 +341,11 @@ fn without_shadow_every_hit_is_plain_blinn_phong_even_where_it_is_negative() {
 fn a_partial_screen_follows_the_size_flags() {
     let text =
         "[camera]\nposition = [0, 0, 1]\n[light]\nposition = [5, 5, 5]\n[screen]\nleft = -1\n";
-    let size = raystep::scene_file::SizeOverride {
+    let size = raystep::io::scene_file::SizeOverride {
         width: Some(100),
         height: Some(100),
     };
-    let scene = raystep::scene_file::parse_sized(text, "t", size).unwrap();
+    let scene = raystep::io::scene_file::parse_sized(text, "t", size).unwrap();
     let screen = scene.screen.unwrap();
     assert_eq!(
         (screen.left, screen.right, screen.top, screen.bottom),

@@ -45,7 +45,7 @@ fn the_fast_engine_leaves_the_books_trace_except_where_it_falls_back() {
     assert_ne!(frame.packets, Packets::Off);
     assert_eq!(frame.book_paths, 0, "the packets trace every pixel");
     // More objects than the packets' masks hold, and no BVH: the book's loop.
-    let mut many = raystep::generate::scene(80, 2);
+    let mut many = raystep::tools::generate::scene(80, 2);
     (many.width, many.height) = (24, 16);
     let plain = Settings {
         accel: raystep::accel::Accel::Off,

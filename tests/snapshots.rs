@@ -5,7 +5,7 @@
 
 mod common;
 
-use raystep::output::{exr_bytes, png_bytes};
+use raystep::io::output::{exr_bytes, png_bytes};
 use raystep::stages::{Stage, Stages};
 
 #[test]
@@ -39,7 +39,7 @@ fn each_small_scene_at_its_stage() {
     ];
     for (name, stage) in cases {
         let path = format!("{}/scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"));
-        let mut scene = raystep::scene_file::load(path.as_ref()).unwrap();
+        let mut scene = raystep::io::scene_file::load(path.as_ref()).unwrap();
         scene.width = 100;
         scene.height = 70;
         let frame = common::render(&scene, Stages::up_to(stage));

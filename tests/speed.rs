@@ -18,7 +18,7 @@ use raystep::samples::stratified;
 use raystep::scene::Scene;
 use raystep::sphere::Method;
 use raystep::stages::{Engine, Stages};
-use raystep::yardstick::Yardstick;
+use raystep::tools::yardstick::Yardstick;
 
 /// Counts the allocations made by the current thread while `COUNTING` is set.
 struct Counting;
@@ -52,7 +52,7 @@ unsafe impl GlobalAlloc for Counting {
 static ALLOCATOR: Counting = Counting;
 
 fn load(path: &str, width: u32, height: u32) -> Scene {
-    let mut scene = raystep::scene_file::load(std::path::Path::new(path)).unwrap();
+    let mut scene = raystep::io::scene_file::load(std::path::Path::new(path)).unwrap();
     (scene.width, scene.height) = (width, height);
     scene
 }
@@ -70,7 +70,7 @@ fn scenes() -> Vec<(String, Scene)> {
             all.push((p.display().to_string(), load(p.to_str().unwrap(), 96, 64)));
         }
     }
-    let mut many = raystep::generate::scene(60, 5);
+    let mut many = raystep::tools::generate::scene(60, 5);
     (many.width, many.height) = (160, 90);
     all.push(("60 generated spheres".into(), many));
     all
@@ -201,7 +201,7 @@ fn packet_settings() -> Vec<(String, Settings)> {
 /// What a reader who has just changed the book's code is told when the fast
 /// engine no longer agrees with it.
 const EDITED_THE_BOOK: &str = "\
-The fast engine (src/fast.rs, src/packet.rs) computes the book's formulas four rays
+The fast engine (src/fast/) computes the book's formulas four rays
 at a time and must give the book engine's bits. If you have just changed the book's
 code (src/render.rs, src/sphere.rs, src/shade/...), this is expected: your change is
 in every default render (raystep render, stages, explain and the figures use the
@@ -257,7 +257,7 @@ fn the_fast_engine_gives_the_book_engines_bits_on_every_scene() {
 
 #[test]
 fn the_bvh_changes_no_pixel_in_float32_with_the_stable_method_either() {
-    let mut scene = raystep::generate::scene(200, 9);
+    let mut scene = raystep::tools::generate::scene(200, 9);
     (scene.width, scene.height) = (160, 90);
     let base = Settings {
         precision: Precision::F32,
@@ -450,7 +450,7 @@ fn early_stop_moves_no_channel_more_than_one_8_bit_level_and_saves_rays() {
 
 #[test]
 fn the_pixel_loop_allocates_nothing() {
-    let mut many = raystep::generate::scene(100, 3);
+    let mut many = raystep::tools::generate::scene(100, 3);
     (many.width, many.height) = (64, 36);
     for (scene, settings) in [
         (common::seed(64, 36), Settings::from(Stages::ALL)),

@@ -50,10 +50,10 @@ impl std::str::FromStr for Offset {
             .strip_prefix("fixed:")
             .ok_or_else(|| format!("`{text}`: expected auto or fixed:VALUE, e.g. fixed:1e-5"))?;
         match value.parse::<f64>() {
-            Ok(v) if (0.0..=crate::scene_file::MAX_MAGNITUDE).contains(&v) => Ok(Offset::Fixed(v)),
+            Ok(v) if (0.0..=crate::scene::MAX_MAGNITUDE).contains(&v) => Ok(Offset::Fixed(v)),
             _ => Err(format!(
                 "`{value}`: the offset must be a number from 0 to {:e}",
-                crate::scene_file::MAX_MAGNITUDE
+                crate::scene::MAX_MAGNITUDE
             )),
         }
     }

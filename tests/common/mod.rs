@@ -7,7 +7,7 @@ use raystep::stages::Stages;
 
 /// The built-in figure-1 scene at `width` × `height`.
 pub fn seed(width: u32, height: u32) -> Scene {
-    let mut scene = raystep::scene_file::seed();
+    let mut scene = raystep::io::scene_file::seed();
     scene.width = width;
     scene.height = height;
     scene
@@ -20,7 +20,7 @@ pub fn render(scene: &Scene, stages: Stages) -> Frame {
 
 /// A scene from TOML text, which must be valid.
 pub fn scene(toml: &str) -> Scene {
-    raystep::scene_file::parse(toml, "test scene").unwrap_or_else(|e| panic!("{e}"))
+    raystep::io::scene_file::parse(toml, "test scene").unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Read a PFM file: (width, height, RGB triples with the top row first).

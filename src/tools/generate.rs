@@ -89,7 +89,7 @@ pub fn spheres_toml(count: usize, seed: u64) -> String {
 /// The scene of [`spheres_toml`], built directly (a million spheres would make a
 /// scene file of 150 MB, beyond what the loader reads).
 pub fn scene(count: usize, seed: u64) -> Scene {
-    let mut scene = crate::scene_file::parse(&spheres_toml(0, seed), "generated")
+    let mut scene = crate::io::scene_file::parse(&spheres_toml(0, seed), "generated")
         .expect("the generated header is a valid scene");
     let floor = scene.objects.pop().expect("the header has the floor");
     scene.objects = spheres(count, seed)
@@ -126,7 +126,7 @@ mod tests {
     #[test]
     fn the_scene_file_and_the_scene_built_directly_agree() {
         let text = spheres_toml(200, 3);
-        let parsed = crate::scene_file::parse(&text, "generated").unwrap();
+        let parsed = crate::io::scene_file::parse(&text, "generated").unwrap();
         assert_eq!(parsed, scene(200, 3));
     }
 

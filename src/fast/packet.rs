@@ -10,7 +10,7 @@
 //! four chains of waiting overlap.
 //!
 //! Nothing else changes. The same formulas are computed in the same order, lane
-//! by lane (see [`crate::lanes`]), so every lane gives bit for bit the record the
+//! by lane (see [`crate::fast::lanes`]), so every lane gives bit for bit the record the
 //! scalar tracer gives for its pixel: `tests/speed.rs` compares the two on every
 //! scene of the repository, and `tests/fuzz.rs` on random ones.
 //!
@@ -48,11 +48,12 @@
 
 use std::borrow::Cow;
 
-use crate::accel::{Accel, TileMasks, EVERY, TILE};
+use crate::accel::{Accel, EVERY};
 use crate::aov::{PixelRecord, Rays};
-use crate::bvh::PacketSearch;
-use crate::lanes::{components, convert, each, powi, F64s, Lanes, ALL, V3, WIDTH};
-use crate::real::{Real, Vector};
+use crate::fast::lanes::{components, convert, each, powi, F64s, Laned, Lanes, ALL, V3, WIDTH};
+use crate::fast::masks::{TileMasks, TILE};
+use crate::fast::walk::PacketSearch;
+use crate::real::Vector;
 use crate::render::{direction_colour, Settings, Tracer, HALF_STEP};
 use crate::samples::stratified;
 use crate::scene::{Light, Object, Scene, Shape};
@@ -72,7 +73,7 @@ pub const MAX_OBJECTS: usize = 64;
 pub const BATCH: usize = 16;
 
 /// What the fast engine needs beside the book's tracer.
-pub struct Fast<T: Real = f64> {
+pub struct Fast<T: Laned = f64> {
     /// The book's tracer, whose rules and objects every lane follows.
     pub book: Tracer<T>,
     /// Samples per pixel (a square number).
@@ -93,15 +94,15 @@ pub struct Fast<T: Real = f64> {
     pub columns: Vec<T>,
 }
 
-impl<T: Real> Fast<T> {
+impl<T: Laned> Fast<T> {
     /// The fast engine for `scene` under `settings`, computing in `T`.
     pub fn new(scene: &Scene, settings: &Settings) -> Fast<T> {
         let book = Tracer::<T>::new(scene, settings);
         assert!(
-            crate::scene_file::check_spp(settings.spp).is_ok(),
+            crate::samples::check_spp(settings.spp).is_ok(),
             "spp {} is not a square from 1 to {}",
             settings.spp,
-            crate::scene_file::MAX_SPP
+            crate::samples::MAX_SPP
         );
         // Packets search a short list by bit masks, a long one through the BVH.
         let packets = book.bvh.is_some() || book.objects.len() <= MAX_OBJECTS;
@@ -118,7 +119,9 @@ impl<T: Real> Fast<T> {
         };
         let columns = match packets {
             true => (0..book.camera.width)
-                .map(|col| crate::lanes::components::<T>(book.camera.screen_point::<T>(0, col))[0])
+                .map(|col| {
+                    crate::fast::lanes::components::<T>(book.camera.screen_point::<T>(0, col))[0]
+                })
                 .collect(),
             false => Vec::new(),
         };
@@ -151,7 +154,7 @@ pub fn has_avx() -> bool {
 /// it out at each hit. Lane `i` of a blend (`Packed::blend`) holds the numbers
 /// of the object hit in lane `i`.
 #[derive(Clone, Copy, Debug)]
-pub struct Packed<T: Real> {
+pub struct Packed<T: Laned> {
     /// The geometry.
     shape: Shape4<T>,
     /// The sphere's radius (zero for a plane).
@@ -181,7 +184,7 @@ pub struct Packed<T: Real> {
 
 /// An object's geometry in every lane: what the intersection test reads.
 #[derive(Clone, Copy, Debug)]
-pub struct Shape4<T: Real> {
+pub struct Shape4<T: Laned> {
     /// The lanes whose object is a sphere (the others are true planes).
     spheres: u32,
     /// The sphere's centre, or the plane's point.
@@ -192,7 +195,7 @@ pub struct Shape4<T: Real> {
     radius_squared: T::Lanes,
 }
 
-impl<T: Real> Shape4<T> {
+impl<T: Laned> Shape4<T> {
     /// The sphere of centre `center` and radius `radius`.
     #[inline(always)]
     fn sphere(center: T::Vec3, radius: T) -> Shape4<T> {
@@ -228,14 +231,14 @@ impl<T: Real> Shape4<T> {
 /// What [`Shape4`] keeps of `object`: is it a sphere, its centre (or the plane's
 /// point), the plane's normal (zero for a sphere), the radius (zero for a plane).
 #[inline(always)]
-fn geometry<T: Real>(object: &Object<T>) -> (bool, T::Vec3, T::Vec3, T) {
+fn geometry<T: Laned>(object: &Object<T>) -> (bool, T::Vec3, T::Vec3, T) {
     match object.shape {
         Shape::Sphere(s) => (true, s.center, T::Vec3::ZERO, s.radius),
         Shape::Plane(p) => (false, p.point, p.normal, T::of(0.0)),
     }
 }
 
-impl<T: Real> Packed<T> {
+impl<T: Laned> Packed<T> {
     /// The numbers of `object` lit by `light`.
     pub fn new(object: &Object<T>, light: &Light<T>) -> Packed<T> {
         Packed::gather([object; WIDTH], light)
@@ -305,14 +308,14 @@ impl<T: Real> Packed<T> {
 
 /// Four rays: lane `i` of `origin` and `direction` is ray `i`.
 #[derive(Clone, Copy, Debug)]
-pub struct Packet<T: Real> {
+pub struct Packet<T: Laned> {
     /// Where the rays start.
     pub origin: V3<T>,
     /// Their unit directions.
     pub direction: V3<T>,
 }
 
-impl<T: Real> Packet<T> {
+impl<T: Laned> Packet<T> {
     /// The points at distances `t`: `O + d·t`.
     #[inline(always)]
     fn at(&self, t: T::Lanes) -> V3<T> {
@@ -322,7 +325,7 @@ impl<T: Real> Packet<T> {
 
 /// What [`Fast::trace_packet`] brings back, lane by lane: the colour, the first
 /// hit (where `hit` has the lane's bit) and the rays traced.
-struct Traced4<T: Real> {
+struct Traced4<T: Laned> {
     /// The sum of the path's light, not yet clipped.
     colour: V3<T>,
     /// The lanes whose primary ray hit something.
@@ -340,7 +343,7 @@ struct Traced4<T: Real> {
     reflection_rays: [u32; WIDTH],
 }
 
-impl<T: Real> Traced4<T> {
+impl<T: Laned> Traced4<T> {
     /// Black, no hit, no rays.
     #[inline(always)]
     fn blank() -> Traced4<T> {
@@ -424,7 +427,7 @@ impl<T: Real> Traced4<T> {
 /// lower index, so that the result does not depend on the order of the tests.
 ///
 /// [`scene::consider`]: crate::scene::consider
-struct Nearest<'a, T: Real> {
+struct Nearest<'a, T: Laned> {
     tracer: &'a Fast<T>,
     ray: &'a Packet<T>,
     alive: u32,
@@ -433,7 +436,7 @@ struct Nearest<'a, T: Real> {
     found: T::Lanes,
 }
 
-impl<T: Real> PacketSearch for Nearest<'_, T> {
+impl<T: Laned> PacketSearch for Nearest<'_, T> {
     fn active(&self) -> u32 {
         self.alive
     }
@@ -455,7 +458,7 @@ impl<T: Real> PacketSearch for Nearest<'_, T> {
     }
 }
 
-impl<T: Real> Nearest<'_, T> {
+impl<T: Laned> Nearest<'_, T> {
     /// Test object `index`, of geometry `shape`, and keep it where it is nearer.
     #[inline(always)]
     fn consider(&mut self, index: usize, shape: &Shape4<T>) {
@@ -488,7 +491,7 @@ impl<T: Real> Nearest<'_, T> {
 }
 
 /// The lanes whose shadow ray is blocked so far.
-struct Blocked<'a, T: Real> {
+struct Blocked<'a, T: Laned> {
     tracer: &'a Fast<T>,
     ray: &'a Packet<T>,
     distance: T::Lanes,
@@ -496,7 +499,7 @@ struct Blocked<'a, T: Real> {
     blocked: u32,
 }
 
-impl<T: Real> PacketSearch for Blocked<'_, T> {
+impl<T: Laned> PacketSearch for Blocked<'_, T> {
     /// The lanes not blocked yet: none, and the search stops.
     fn active(&self) -> u32 {
         self.alive & !self.blocked
@@ -518,7 +521,7 @@ impl<T: Real> PacketSearch for Blocked<'_, T> {
     }
 }
 
-impl<T: Real> Blocked<'_, T> {
+impl<T: Laned> Blocked<'_, T> {
     /// Test an object of geometry `shape`: does it stand before the light?
     #[inline(always)]
     fn consider(&mut self, shape: &Shape4<T>) {
@@ -546,7 +549,7 @@ fn count(counts: &mut [u32; WIDTH], bits: u32) {
     }
 }
 
-impl<T: Real> Fast<T> {
+impl<T: Laned> Fast<T> {
     // ANCHOR: packet
     /// The records of pixels `col`, `col + 1`, … of row `row`, one per element of
     /// `out` (at most [`WIDTH`]), traced as one packet from their primary rays `ray`
@@ -1018,7 +1021,7 @@ impl<T: Real> Fast<T> {
 }
 
 /// Blinn-Phong's terms in each lane: their sum, and the factors the buffers keep.
-struct Terms4<T: Real> {
+struct Terms4<T: Laned> {
     sum: V3<T>,
     l_dot_n: T::Lanes,
     highlight: T::Lanes,

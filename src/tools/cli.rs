@@ -10,11 +10,11 @@ use crate::accel::Accel;
 use crate::aov::Frame;
 use crate::engine::render;
 use crate::error::Error;
-use crate::output::Pending;
+use crate::io::output::Pending;
+use crate::io::scene_file::{self, check_max_depth, SizeOverride};
 use crate::real::Precision;
 use crate::render::Settings;
 use crate::scene::{Role, Scene, Shape};
-use crate::scene_file::{self, check_max_depth, SizeOverride};
 use crate::shade::blinn_phong::Viewer;
 use crate::shade::shadow::Offset;
 use crate::sphere::Method;
@@ -352,7 +352,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
             match args.what {
                 Generated::Spheres { count, seed } => {
                     use std::io::Write;
-                    let text = crate::generate::spheres_toml(count as usize, seed);
+                    let text = crate::tools::generate::spheres_toml(count as usize, seed);
                     let _ = std::io::stdout().lock().write_all(text.as_bytes());
                 }
             }
@@ -384,7 +384,7 @@ impl RuleArgs {
             Settings::from(stages)
         };
         if let Some(spp) = self.spp {
-            crate::scene_file::check_spp(spp).map_err(Error::Usage)?;
+            crate::io::scene_file::check_spp(spp).map_err(Error::Usage)?;
         }
         Ok(Settings {
             stages,
@@ -469,7 +469,7 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
     let bar = progress_bar(u64::from(scene.height) * Stage::ALL.len() as u64);
     let start = Instant::now();
     let mut page = Vec::new(); // a row of index.html per stage
-    let mut sheet = crate::contact::ContactSheet::new(crate::contact::THUMBNAIL_WIDTH);
+    let mut sheet = crate::io::contact::ContactSheet::new(crate::io::contact::THUMBNAIL_WIDTH);
     for stage in Stage::ALL {
         bar.set_message(stage.folder());
         let dir = args.out.join(stage.folder());
@@ -478,18 +478,18 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
             ..base
         };
         let (frame, seconds) = timed(|| render(&scene, &settings, &|n| bar.inc(n)));
-        crate::interrupt::check()?;
+        crate::error::check_interrupt()?;
         pending.folder(&dir)?;
         write(&mut pending, &frame, &dir, seconds, &bar)?;
         // The numbers behind the pictures, for the page (up to a size).
-        if crate::page::has_numbers(scene.width, scene.height) {
-            crate::page::write_pixels(&mut pending, &dir, &stage.folder(), &frame)?;
+        if crate::io::page::has_numbers(scene.width, scene.height) {
+            crate::io::page::write_pixels(&mut pending, &dir, &stage.folder(), &frame)?;
         } else {
-            pending.remove_on_commit(&dir.join(crate::page::PIXELS_FILE));
+            pending.remove_on_commit(&dir.join(crate::io::page::PIXELS_FILE));
         }
         let label = stage.label();
         sheet.add_row(&label, &frame);
-        page.push(crate::page::PageStage {
+        page.push(crate::io::page::PageStage {
             folder: stage.folder(),
             label,
             buffers: frame.buffers().map(|b| b.name().to_string()).collect(),
@@ -500,7 +500,7 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
     bar.finish_and_clear();
     let contact = args.out.join(CONTACT_SHEET);
     pending.file(&contact, &sheet.png())?;
-    let index = crate::page::write_index(
+    let index = crate::io::page::write_index(
         &mut pending,
         &args.out,
         &name,
@@ -535,7 +535,7 @@ fn explain(args: &ExplainArgs) -> Result<(), Error> {
             scene.height - 1
         )));
     }
-    let story = crate::explain::explain(&scene, &settings, x, y);
+    let story = crate::tools::explain::explain(&scene, &settings, x, y);
     if args.json {
         let json = serde_json::to_string_pretty(&story).expect("an explanation is plain data");
         say!("{json}");
@@ -566,7 +566,7 @@ fn render_one(args: RenderArgs) -> Result<(), Error> {
     let bar = progress_bar(u64::from(scene.height));
     let (frame, seconds) = timed(|| render(&scene, &settings, &|n| bar.inc(n)));
     bar.finish_and_clear();
-    crate::interrupt::check()?;
+    crate::error::check_interrupt()?;
     write(&mut pending, &frame, &args.out, seconds, &bar)?;
     pending.commit()
 }
@@ -605,7 +605,7 @@ fn bench(mut args: BenchArgs) -> Result<(), Error> {
     let threads = args
         .threads
         .map_or_else(rayon::current_num_threads, |t| t as usize);
-    let options = crate::bench::Options {
+    let options = crate::tools::bench::Options {
         runs: args.runs as usize,
         threads,
         yardstick: !args.no_yardstick,
@@ -614,9 +614,9 @@ fn bench(mut args: BenchArgs) -> Result<(), Error> {
         say!("{name}: {}", settings.stages);
     }
     let bar = counted_bar(u64::from(args.runs) + 1, "bench", "runs");
-    let report = crate::bench::bench(&scene, &settings, options, &|n| bar.inc(n))?;
+    let report = crate::tools::bench::bench(&scene, &settings, options, &|n| bar.inc(n))?;
     bar.finish_and_clear();
-    crate::interrupt::check()?;
+    crate::error::check_interrupt()?;
     if args.json {
         let json = serde_json::to_string(&report).expect("a report is always valid JSON");
         say!("{json}");
@@ -640,7 +640,7 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
             args.scene.width.unwrap_or(1920),
             args.scene.height.unwrap_or(1080),
         );
-        crate::scene_file::check_image_size((size.0, "--width"), (size.1, "--height"))
+        crate::io::scene_file::check_image_size((size.0, "--width"), (size.1, "--height"))
             .map_err(Error::Usage)?;
         let counts: Vec<usize> = (0..8)
             .flat_map(|e| [10usize.pow(e), 3 * 10usize.pow(e)])
@@ -658,13 +658,14 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
             counts.len()
         );
         let bar = counted_bar(renders, "scale", "renders");
-        let points = crate::chart::scale(&counts, plain_up_to, size, runs, &|n| bar.inc(n));
+        let points = crate::tools::chart::scale(&counts, plain_up_to, size, runs, &|n| bar.inc(n));
         bar.finish_and_clear();
-        crate::interrupt::check()?;
-        let csv = crate::chart::scale_csv(&points);
+        crate::error::check_interrupt()?;
+        let csv = crate::tools::chart::scale_csv(&points);
         pending.file(&args.out.join("scale.csv"), csv.as_bytes())?;
         let title = format!("Time against spheres, {} × {}, every stage", size.0, size.1);
-        let files = crate::chart::write_scale(&mut pending, &args.out, "scale", &points, &title)?;
+        let files =
+            crate::tools::chart::write_scale(&mut pending, &args.out, "scale", &points, &title)?;
         pending.commit()?;
         say!("{}", csv.trim_end());
         say!("wrote {}/scale.csv, {}", args.out.display(), names(&files));
@@ -677,17 +678,18 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
         scene.width,
         scene.height
     );
-    let bar = counted_bar(crate::chart::sweep_renders(runs), "chart", "renders");
-    let points = crate::chart::sweep(&scene, runs, &|n| bar.inc(n));
+    let bar = counted_bar(crate::tools::chart::sweep_renders(runs), "chart", "renders");
+    let points = crate::tools::chart::sweep(&scene, runs, &|n| bar.inc(n));
     bar.finish_and_clear();
-    crate::interrupt::check()?;
-    let csv = crate::chart::csv(&points);
+    crate::error::check_interrupt()?;
+    let csv = crate::tools::chart::csv(&points);
     pending.file(&args.out.join("chart.csv"), csv.as_bytes())?;
     let title = format!(
         "Speed against accuracy: {name}, {} × {}",
         scene.width, scene.height
     );
-    let files = crate::chart::write_sweep(&mut pending, &args.out, "chart", &points, &title)?;
+    let files =
+        crate::tools::chart::write_sweep(&mut pending, &args.out, "chart", &points, &title)?;
     pending.commit()?;
     say!("{}", csv.trim_end());
     say!("wrote {}/chart.csv, {}", args.out.display(), names(&files));
@@ -727,8 +729,8 @@ fn counted_bar(len: u64, label: &str, unit: &str) -> ProgressBar {
 }
 
 fn diff(args: &DiffArgs) -> Result<(), Error> {
-    let (wa, ha, a) = crate::compare::read_beauty(&args.a)?;
-    let (wb, hb, b) = crate::compare::read_beauty(&args.b)?;
+    let (wa, ha, a) = crate::tools::compare::read_beauty(&args.a)?;
+    let (wb, hb, b) = crate::tools::compare::read_beauty(&args.b)?;
     if (wa, ha) != (wb, hb) {
         return Err(Error::Usage(format!(
             "{} is {wa} × {ha} but {} is {wb} × {hb}: only renders of one size compare",
@@ -736,7 +738,7 @@ fn diff(args: &DiffArgs) -> Result<(), Error> {
             args.b.display()
         )));
     }
-    let d = crate::compare::compare(&a, &b, wa);
+    let d = crate::tools::compare::compare(&a, &b, wa);
     say!(
         "{} against {}: {wa} × {ha} pixels",
         args.a.display(),
@@ -763,7 +765,7 @@ fn diff(args: &DiffArgs) -> Result<(), Error> {
 }
 
 fn accuracy(args: &AccuracyArgs) -> Result<(), Error> {
-    use crate::accuracy::{measure_all, CASES};
+    use crate::tools::accuracy::{measure_all, CASES};
     if let Some(case) = &args.case {
         if !CASES.iter().any(|(n, _)| n == case) {
             let names: Vec<&str> = CASES.iter().map(|(n, _)| *n).collect();
@@ -774,7 +776,7 @@ fn accuracy(args: &AccuracyArgs) -> Result<(), Error> {
         }
     }
     let rows = match &args.case {
-        Some(case) => crate::accuracy::measure_case(case),
+        Some(case) => crate::tools::accuracy::measure_case(case),
         None => measure_all(),
     };
     if args.json {
@@ -784,9 +786,9 @@ fn accuracy(args: &AccuracyArgs) -> Result<(), Error> {
         );
         return Ok(());
     }
-    say!("{}", crate::accuracy::table_header());
+    say!("{}", crate::tools::accuracy::table_header());
     for m in &rows {
-        say!("{}", crate::accuracy::table_row(m));
+        say!("{}", crate::tools::accuracy::table_row(m));
     }
     Ok(())
 }
@@ -794,7 +796,7 @@ fn accuracy(args: &AccuracyArgs) -> Result<(), Error> {
 fn figures(args: &FiguresArgs) -> Result<(), Error> {
     let root = Path::new(".");
     if args.check {
-        let problems = crate::figures::check_all(root, &args.out)?;
+        let problems = crate::tools::figures::check_all(root, &args.out, &render_command)?;
         if problems.is_empty() {
             say!(
                 "every figure in {} is what raystep renders now",
@@ -808,7 +810,7 @@ fn figures(args: &FiguresArgs) -> Result<(), Error> {
             problems.join("\n  ")
         )));
     }
-    let written = crate::figures::write_all(root, &args.out)?;
+    let written = crate::tools::figures::write_all(root, &args.out, &render_command)?;
     say!(
         "wrote {} figures into {}/",
         written.len(),
@@ -880,4 +882,20 @@ pub fn describe(scene: &Scene, name: &str) -> String {
         }
     }
     out
+}
+
+/// The frame that `raystep ARGS` renders, for a `render` command; scene paths in
+/// `args` are relative to `root`.
+pub fn render_command(args: &str, root: &Path) -> Result<Frame, Error> {
+    let words = std::iter::once("raystep").chain(args.split_whitespace());
+    let cli =
+        Cli::try_parse_from(words).map_err(|e| Error::Usage(format!("`raystep {args}`: {e}")))?;
+    let Some(Command::Render(mut render)) = cli.command else {
+        return Err(Error::Usage(format!(
+            "`raystep {args}` is not a render command"
+        )));
+    };
+    render.frame.scene.scene = render.frame.scene.scene.map(|p| root.join(p));
+    let (scene, settings) = prepare(&render.frame)?;
+    Ok(crate::render::render(&scene, &settings, &|_| {}))
 }

@@ -2,7 +2,7 @@
 //! column per buffer, so that the whole progression is one picture.
 //!
 //! Each cell is the buffer's 8-bit picture (the same as its PNG file,
-//! [`crate::output::visualise`]) scaled down to a thumbnail; a buffer the frame does
+//! [`crate::io::output::visualise`]) scaled down to a thumbnail; a buffer the frame does
 //! not hold is an empty cell marked "not written". Layout, in pixels:
 //!
 //! ```text
@@ -127,7 +127,7 @@ impl ContactSheet {
             let picture = RgbImage::from_raw(
                 frame.width,
                 frame.height,
-                crate::output::visualise(frame, buffer),
+                crate::io::output::visualise(frame, buffer),
             )
             .expect("visualise gives 3 bytes per pixel");
             Some(if (width, height) == (frame.width, frame.height) {
@@ -290,7 +290,7 @@ fn text_width(text: &str, size: f64) -> u32 {
 }
 
 /// Make the built-in DejaVu Sans the "sans-serif" of plotters (once), as
-/// [`crate::chart`] does for its charts: the same name and the same font, so
+/// [`crate::tools::chart`] does for its charts: the same name and the same font, so
 /// whichever registers first, both draw alike.
 fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
@@ -298,7 +298,7 @@ fn register_font() {
         plotters::style::register_font(
             "sans-serif",
             FontStyle::Normal,
-            include_bytes!("../assets/DejaVuSans.ttf"),
+            include_bytes!("../../assets/DejaVuSans.ttf"),
         )
         .unwrap_or_else(|_| panic!("the built-in font is a valid TrueType font"));
     });
@@ -307,8 +307,8 @@ fn register_font() {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::scene_file::{parse_sized, SizeOverride, SEED_NAME, SEED_TOML};
     use crate::render::{render, Settings};
-    use crate::scene_file::{parse_sized, SizeOverride, SEED_NAME, SEED_TOML};
     use crate::stages::{Stage, Stages};
 
     /// The seed scene at `width × height`, every stage, into a sheet of thumbnails
@@ -382,7 +382,7 @@ mod tests {
         }
         // The thumbnails are the buffers' pictures, scaled: the plane stage's, again.
         for (c, &buffer) in COLUMNS.iter().enumerate() {
-            let full = RgbImage::from_raw(120, 80, crate::output::visualise(&last, buffer));
+            let full = RgbImage::from_raw(120, 80, crate::io::output::visualise(&last, buffer));
             let expected = imageops::resize(&full.unwrap(), tw, th, FilterType::Triangle);
             assert_eq!(sheet.rows[5].cells[c].as_ref(), Some(&expected));
         }

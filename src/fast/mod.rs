@@ -2,27 +2,32 @@
 //!
 //! It is built on the book's [`Tracer`](crate::render::Tracer) and reads everything from it: the objects,
 //! the light, the rules, the BVH. What it adds never changes a pixel: rays traced
-//! four at a time in SIMD lanes ([`crate::packet`]), tile masks that skip objects
-//! a tile's primary rays cannot hit ([`TileMasks`](crate::accel::TileMasks)), and a packet walk of the
+//! four at a time in SIMD lanes ([`crate::fast::packet`]), tile masks that skip objects
+//! a tile's primary rays cannot hit ([`TileMasks`](masks::TileMasks)), and a packet walk of the
 //! BVH. `tests/speed.rs` holds it to the book's bits on every scene and setting.
 //! The book's files never import this one.
 //!
-//! What it does not take in packets (more than [`MAX_OBJECTS`](crate::packet::MAX_OBJECTS) objects without
+//! What it does not take in packets (more than [`MAX_OBJECTS`](crate::fast::packet::MAX_OBJECTS) objects without
 //! a BVH), it traces with the book's own row loop, and says so in the frame
 //! ([`Frame::packets`] is then `off`).
+
+pub mod lanes;
+pub mod masks;
+pub mod packet;
+pub mod walk;
 
 use rayon::prelude::*;
 
 use crate::aov::{Frame, Packets, PixelRecord, Rays};
-use crate::lanes::WIDTH;
-pub use crate::packet::Fast;
-use crate::packet::BATCH;
-use crate::real::{Precision, Real};
+use crate::fast::lanes::{Laned, WIDTH};
+pub use crate::fast::packet::Fast;
+use crate::fast::packet::BATCH;
+use crate::real::Precision;
 use crate::render::{book_row, Settings};
 use crate::scene::Scene;
 use crate::stages::Engine;
 
-impl<T: Real> Fast<T> {
+impl<T: Laned> Fast<T> {
     // ANCHOR: packet_row
     /// The records of row `row`, four pixels at a time ([`Fast::pixel_packet`]),
     /// into `line`, and the rays they took.
@@ -126,7 +131,7 @@ pub fn render_into(
 }
 
 /// [`render_into`] by `fast`: rows in parallel.
-fn render_in<T: Real>(
+fn render_in<T: Laned>(
     fast: &Fast<T>,
     scene: &Scene,
     settings: &Settings,

@@ -12,7 +12,7 @@
 use serde::Serialize;
 
 use crate::aov::Rays;
-use crate::output::to_byte;
+use crate::io::output::to_byte;
 use crate::ray::Ray;
 use crate::real::{Real, Vector};
 use crate::render::{direction_colour, End, Observer, Settings, Tracer};

@@ -12,7 +12,7 @@
 //! A setting is on the Pareto frontier when no other setting is both faster and
 //! more accurate.
 //!
-//! **Scale.** Generated scenes of N spheres ([`crate::generate`]) at the chart's
+//! **Scale.** Generated scenes of N spheres ([`crate::tools::generate`]) at the chart's
 //! size, rendered with `--accel auto` and with the plain loop (`--accel off`, up to
 //! the count where it becomes too slow to wait for).
 
@@ -27,10 +27,9 @@ use plotters::style::FontStyle;
 
 use crate::accel::Accel;
 use crate::aov::Frame;
-use crate::bench::median;
 use crate::engine::render_into;
 use crate::error::Error;
-use crate::output::Pending;
+use crate::io::output::Pending;
 use crate::real::Precision;
 use crate::render::Settings;
 use crate::scene::Scene;
@@ -38,10 +37,11 @@ use crate::shade::shadow::Offset;
 use crate::sphere::Method;
 use crate::stages::Engine;
 use crate::stages::Stages;
+use crate::tools::bench::median;
 
 /// The font of the PNG charts, built in so that no system font is needed
 /// (DejaVu Sans; its licence is in `assets/DejaVuSans-LICENSE.txt`).
-const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+const FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
 /// One setting of the sweep, measured.
 #[derive(Clone, Debug)]
@@ -281,7 +281,7 @@ pub fn scale(
 ) -> Vec<ScalePoint> {
     let mut points = Vec::new();
     for &count in counts {
-        let mut scene = crate::generate::scene(count, 1);
+        let mut scene = crate::tools::generate::scene(count, 1);
         (scene.width, scene.height) = (width, height);
         let objects: Vec<crate::scene::Object> = scene.objects_in_play(Stages::ALL);
         let start = Instant::now();

@@ -17,7 +17,7 @@ use crate::sphere::Sphere;
 use crate::Vec3;
 
 /// The tutorial's figure-1 scene (`scenes/seed.toml`), built into the binary.
-pub const SEED_TOML: &str = include_str!("../scenes/seed.toml");
+pub const SEED_TOML: &str = include_str!("../../scenes/seed.toml");
 
 /// The name errors and summaries use for the built-in scene.
 pub const SEED_NAME: &str = "scenes/seed.toml (built in)";
@@ -35,9 +35,7 @@ pub const MAX_PIXELS: u64 = 7680 * 4320;
 /// 1.91 GB (58 bytes per pixel), and `raystep stages` at that size at 1.94 GB.
 pub const PEAK_BYTES_PER_PIXEL: u64 = 64;
 
-/// Largest magnitude accepted for any number in a scene: squares of coordinates
-/// stay far inside float32's and float64's range.
-pub const MAX_MAGNITUDE: f64 = 1e15;
+pub use crate::scene::MAX_MAGNITUDE;
 
 /// Smallest accepted radius of a sphere.
 pub const MIN_RADIUS: f64 = 1e-12;
@@ -329,26 +327,7 @@ pub fn check_max_depth(max_depth: u32, source: &str) -> Result<(), String> {
     }
 }
 
-/// Most samples per pixel (`--spp`): 32 × 32.
-pub const MAX_SPP: u32 = 1024;
-
-/// Refuse a sample count that is not a square from 1 to [`MAX_SPP`] (the samples
-/// of a pixel form an n × n grid of strata).
-pub fn check_spp(spp: u32) -> Result<(), String> {
-    let n = spp.isqrt();
-    if !(1..=MAX_SPP).contains(&spp) {
-        Err(format!("--spp {spp}: must be from 1 to {MAX_SPP}"))
-    } else if n * n != spp {
-        Err(format!(
-            "--spp {spp}: must be a square number (1, 4, 9, 16, …), so that the samples \
-             form an n × n grid over the pixel; the nearest are {} and {}",
-            n * n,
-            (n + 1) * (n + 1)
-        ))
-    } else {
-        Ok(())
-    }
-}
+pub use crate::samples::{check_spp, MAX_SPP};
 
 /// Three numbers `[x, y, z]`: exactly three, so that a fourth is an error, not
 /// silently dropped.

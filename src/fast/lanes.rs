@@ -1,4 +1,4 @@
-//! Four numbers at once: the SIMD lanes the [packet tracer](crate::packet)
+//! Four numbers at once: the SIMD lanes the [packet tracer](crate::fast::packet)
 //! computes in.
 //!
 //! [`Lanes`] is to four rays what [`Real`] is to one: the few operations the
@@ -22,6 +22,21 @@ use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
 use crate::real::{Real, Vector};
 
+/// A [`Real`] that the fast engine can put four to a SIMD register: the lane
+/// type of its precision. (The book's number trait knows nothing of lanes.)
+pub trait Laned: Real {
+    /// Four numbers of this precision in SIMD lanes.
+    type Lanes: Lanes<Self>;
+}
+
+impl Laned for f32 {
+    type Lanes = wide::f32x4;
+}
+
+impl Laned for f64 {
+    type Lanes = F64x4;
+}
+
 /// The number of lanes: rays traced together.
 pub const WIDTH: usize = 4;
 
@@ -38,15 +53,15 @@ pub fn each<R>(mut f: impl FnMut(usize) -> R) -> [R; WIDTH] {
 
 /// Four numbers of float64 (the limits of a packet's search, whatever its
 /// precision).
-pub type F64s = <f64 as Real>::Lanes;
+pub type F64s = <f64 as Laned>::Lanes;
 
 /// Four numbers of float32 (the BVH's box tests).
-pub type F32s = <f32 as Real>::Lanes;
+pub type F32s = <f32 as Laned>::Lanes;
 
 /// The lanes `l` in precision `L`: exact into a wider precision, rounded to
 /// nearest into a narrower one.
 #[inline(always)]
-pub fn convert<T: Real, L: Real>(l: T::Lanes) -> L::Lanes {
+pub fn convert<T: Laned, L: Laned>(l: T::Lanes) -> L::Lanes {
     let l = l.to_array();
     L::Lanes::from_array(each(|i| L::of(l[i].to_f64())))
 }
@@ -377,7 +392,7 @@ impl Lanes<f64> for F64x4 {
 
 /// A 3-vector of lanes of precision `T`: lane `i` of `x`, `y` and `z` is vector `i`.
 #[derive(Clone, Copy, Debug)]
-pub struct V3<T: Real> {
+pub struct V3<T: Laned> {
     /// The x components.
     pub x: T::Lanes,
     /// The y components.
@@ -386,7 +401,7 @@ pub struct V3<T: Real> {
     pub z: T::Lanes,
 }
 
-impl<T: Real> V3<T> {
+impl<T: Laned> V3<T> {
     /// The vector of lanes from its three components.
     #[inline(always)]
     pub fn new(x: T::Lanes, y: T::Lanes, z: T::Lanes) -> V3<T> {
@@ -402,7 +417,7 @@ impl<T: Real> V3<T> {
 
     /// The vectors in precision `L` ([`convert`] of each coordinate).
     #[inline(always)]
-    pub fn convert<L: Real>(&self) -> V3<L> {
+    pub fn convert<L: Laned>(&self) -> V3<L> {
         V3::new(
             convert::<T, L>(self.x),
             convert::<T, L>(self.y),
@@ -473,12 +488,12 @@ impl<T: Real> V3<T> {
 
 /// The three components of a vector (exactly: through float64 and back).
 #[inline(always)]
-pub fn components<T: Real>(v: T::Vec3) -> [T; 3] {
+pub fn components<T: Laned>(v: T::Vec3) -> [T; 3] {
     let d = v.to_f64();
     [T::of(d.x), T::of(d.y), T::of(d.z)]
 }
 
-impl<T: Real> Add for V3<T> {
+impl<T: Laned> Add for V3<T> {
     type Output = V3<T>;
     #[inline(always)]
     fn add(self, o: V3<T>) -> V3<T> {
@@ -486,7 +501,7 @@ impl<T: Real> Add for V3<T> {
     }
 }
 
-impl<T: Real> Sub for V3<T> {
+impl<T: Laned> Sub for V3<T> {
     type Output = V3<T>;
     #[inline(always)]
     fn sub(self, o: V3<T>) -> V3<T> {
@@ -494,7 +509,7 @@ impl<T: Real> Sub for V3<T> {
     }
 }
 
-impl<T: Real> Neg for V3<T> {
+impl<T: Laned> Neg for V3<T> {
     type Output = V3<T>;
     #[inline(always)]
     fn neg(self) -> V3<T> {
@@ -503,7 +518,7 @@ impl<T: Real> Neg for V3<T> {
 }
 
 /// Component by component (colours).
-impl<T: Real> Mul for V3<T> {
+impl<T: Laned> Mul for V3<T> {
     type Output = V3<T>;
     #[inline(always)]
     fn mul(self, o: V3<T>) -> V3<T> {
@@ -511,7 +526,7 @@ impl<T: Real> Mul for V3<T> {
     }
 }
 
-impl<T: Real> V3<T> {
+impl<T: Laned> V3<T> {
     /// Each component times the lane's number (`Mul<T::Lanes>` would clash with
     /// the component-wise product for the compiler, so it has a name).
     #[inline(always)]
@@ -524,7 +539,7 @@ impl<T: Real> V3<T> {
 /// `powi` (compiler-builtins' `__powidf2`: multiply the result by `x^(2^k)` for
 /// each set bit `k` of `n`, lowest first), so that each lane rounds as `powi` does.
 #[inline(always)]
-pub fn powi<T: Real>(x: T::Lanes, n: [u32; WIDTH]) -> T::Lanes {
+pub fn powi<T: Laned>(x: T::Lanes, n: [u32; WIDTH]) -> T::Lanes {
     let one = T::Lanes::splat(T::of(1.0));
     if n.iter().all(|&k| k == n[0]) {
         // One exponent for every lane (all four hit the same object): no masks.

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use crate::error::Error;
-use crate::scene_file::MAX_PIXELS;
+use crate::io::scene_file::MAX_PIXELS;
 
 /// How two images of the same size differ.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -20,7 +20,7 @@ use serde::Serialize;
 
 use crate::aov::{Buffer, Frame, PixelRecord, NO_OBJECT};
 use crate::error::Error;
-use crate::output::Pending;
+use crate::io::output::Pending;
 
 /// The page's file, in the folder of `raystep stages`.
 pub const INDEX_FILE: &str = "index.html";
@@ -43,9 +43,9 @@ pub const FIELDS: [&str; 11] = [
     "R", "G", "B", "depth", "N.X", "N.Y", "N.Z", "shadow", "object", "bounces", "rays",
 ];
 
-const TEMPLATE: &str = include_str!("../assets/page/index.html");
-const STYLE: &str = include_str!("../assets/page/page.css");
-const SCRIPT: &str = include_str!("../assets/page/page.js");
+const TEMPLATE: &str = include_str!("../../assets/page/index.html");
+const STYLE: &str = include_str!("../../assets/page/page.css");
+const SCRIPT: &str = include_str!("../../assets/page/page.js");
 
 /// One row of the page's grid: a stage, and the buffers (PNG names without
 /// `.png`) it wrote.
@@ -220,7 +220,7 @@ mod tests {
     }
 
     fn frame(width: u32, height: u32, last: Stage) -> Frame {
-        let mut scene = crate::scene_file::seed();
+        let mut scene = crate::io::scene_file::seed();
         scene.width = width;
         scene.height = height;
         crate::render::render(&scene, &Stages::up_to(last).into(), &|_| {})

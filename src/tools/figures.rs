@@ -5,11 +5,13 @@
 
 use std::path::{Path, PathBuf};
 
-use clap::Parser;
-
 use crate::aov::{Buffer, Frame};
-use crate::cli::{Cli, Command};
 use crate::error::Error;
+
+/// What renders a figure: the frame of `raystep ARGS` with scene paths relative to
+/// `ROOT` (the command line's [`render_command`](crate::tools::cli::render_command),
+/// which parses ARGS as `raystep` does).
+pub type Renderer<'a> = &'a dyn Fn(&str, &Path) -> Result<Frame, Error>;
 
 /// One picture of the book: `raystep ARGS`, keeping some of its buffers.
 #[derive(Clone, Copy, Debug)]
@@ -68,8 +70,8 @@ pub const CONTACT_SHEET: &str = "ch11/contact-sheet.png";
 /// [`CONTACT_SHEET`]'s bytes: every stage of the built-in scene, as `raystep
 /// stages` renders them.
 pub fn contact_sheet() -> Vec<u8> {
-    let scene = crate::scene_file::seed();
-    let mut sheet = crate::contact::ContactSheet::new(crate::contact::THUMBNAIL_WIDTH);
+    let scene = crate::io::scene_file::seed();
+    let mut sheet = crate::io::contact::ContactSheet::new(crate::io::contact::THUMBNAIL_WIDTH);
     for stage in crate::stages::Stage::ALL {
         let settings = crate::render::Settings::from(crate::stages::Stages::up_to(stage));
         sheet.add_row(
@@ -81,10 +83,10 @@ pub fn contact_sheet() -> Vec<u8> {
 }
 
 /// Every file `raystep figures` writes under `chapters/img/`: (file, bytes).
-fn every_file(root: &Path) -> Result<Vec<(String, Vec<u8>, String)>, Error> {
+fn every_file(root: &Path, run: Renderer) -> Result<Vec<(String, Vec<u8>, String)>, Error> {
     let mut files = Vec::new();
     for figure in FIGURES {
-        for (file, bytes) in figure.render(root)? {
+        for (file, bytes) in figure.render(root, run)? {
             files.push((file, bytes, format!("raystep {}", figure.args)));
         }
     }
@@ -112,37 +114,21 @@ impl Figure {
 
     /// Render the figure; scene paths in `args` are relative to `root`. Returns each
     /// kept buffer's file name and PNG bytes.
-    pub fn render(&self, root: &Path) -> Result<Vec<(String, Vec<u8>)>, Error> {
-        let frame = render_command(self.args, root)?;
+    pub fn render(&self, root: &Path, run: Renderer) -> Result<Vec<(String, Vec<u8>)>, Error> {
+        let frame = run(self.args, root)?;
         Ok(self
             .buffers
             .iter()
-            .map(|&b| (self.file(b), crate::output::png_bytes(&frame, b)))
+            .map(|&b| (self.file(b), crate::io::output::png_bytes(&frame, b)))
             .collect())
     }
 }
 
-/// The frame that `raystep ARGS` renders, for a `render` command; scene paths in
-/// `args` are relative to `root`.
-pub fn render_command(args: &str, root: &Path) -> Result<Frame, Error> {
-    let words = std::iter::once("raystep").chain(args.split_whitespace());
-    let cli =
-        Cli::try_parse_from(words).map_err(|e| Error::Usage(format!("`raystep {args}`: {e}")))?;
-    let Some(Command::Render(mut render)) = cli.command else {
-        return Err(Error::Usage(format!(
-            "`raystep {args}` is not a render command"
-        )));
-    };
-    render.frame.scene.scene = render.frame.scene.scene.map(|p| root.join(p));
-    let (scene, settings) = crate::cli::prepare(&render.frame)?;
-    Ok(crate::render::render(&scene, &settings, &|_| {}))
-}
-
 /// Render every figure into `out` (normally `chapters/img`); scenes are read
 /// relative to `root`. Returns the files written.
-pub fn write_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>, Error> {
+pub fn write_all(root: &Path, out: &Path, run: Renderer) -> Result<Vec<PathBuf>, Error> {
     let mut written = Vec::new();
-    for (file, bytes, _) in every_file(root)? {
+    for (file, bytes, _) in every_file(root, run)? {
         let path = out.join(file);
         if let Some(dir) = path.parent() {
             std::fs::create_dir_all(dir).map_err(|e| Error::Output {
@@ -150,7 +136,7 @@ pub fn write_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>, Error> {
                 message: e.to_string(),
             })?;
         }
-        crate::output::write_atomically(&path, &bytes)?;
+        crate::io::output::write_atomically(&path, &bytes)?;
         written.push(path);
     }
     Ok(written)
@@ -158,10 +144,10 @@ pub fn write_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>, Error> {
 
 /// Re-render every figure and compare with the files in `out`: the problems found
 /// (a missing file, different bytes, a PNG in `out` that no figure makes).
-pub fn check_all(root: &Path, out: &Path) -> Result<Vec<String>, Error> {
+pub fn check_all(root: &Path, out: &Path, run: Renderer) -> Result<Vec<String>, Error> {
     let mut problems = Vec::new();
     let mut expected = Vec::new();
-    for (file, bytes, command) in every_file(root)? {
+    for (file, bytes, command) in every_file(root, run)? {
         let path = out.join(&file);
         match std::fs::read(&path) {
             Err(_) => problems.push(format!("{file}: missing ({command})")),

@@ -162,7 +162,7 @@ impl Pending {
     /// Rename every file into place, then remove the stale ones; refused with
     /// [`Error::Interrupted`] (and everything removed) after Ctrl-C.
     pub fn commit(mut self) -> Result<(), Error> {
-        crate::interrupt::check()?;
+        crate::error::check_interrupt()?;
         let files = std::mem::take(&mut self.files);
         for (i, (temporary, path)) in files.iter().enumerate() {
             if let Err(e) = fs::rename(temporary, path) {

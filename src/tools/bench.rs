@@ -3,7 +3,7 @@
 //! Four things are timed, their runs interleaved so that a noisy machine slows
 //! all of them alike: the engine asked for (`--engine`, default `fast`) with the
 //! threads asked for and with one thread, the other engine with the threads asked
-//! for, and the [yardstick](crate::yardstick) (the tutorial's program ported
+//! for, and the [yardstick](crate::tools::yardstick) (the tutorial's program ported
 //! plainly) with the same threads. Each is rendered once to warm up, then
 //! `runs` times; the median of the runs is reported. Only the render is timed:
 //! the frame is allocated once, before the runs, and no file is written.
@@ -18,7 +18,7 @@ use crate::error::Error;
 use crate::render::Settings;
 use crate::scene::Scene;
 use crate::stages::Engine;
-use crate::yardstick::Yardstick;
+use crate::tools::yardstick::Yardstick;
 
 /// What `raystep bench` reports (its `--json` output).
 #[derive(Clone, Debug, Serialize)]

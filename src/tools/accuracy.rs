@@ -23,35 +23,35 @@ use crate::Vec3;
 pub const CASES: &[(&str, &str)] = &[
     (
         "far-sphere",
-        include_str!("../scenes/stress/far-sphere.toml"),
+        include_str!("../../scenes/stress/far-sphere.toml"),
     ),
     (
         "tiny-sphere",
-        include_str!("../scenes/stress/tiny-sphere.toml"),
+        include_str!("../../scenes/stress/tiny-sphere.toml"),
     ),
-    ("horizon", include_str!("../scenes/stress/horizon.toml")),
+    ("horizon", include_str!("../../scenes/stress/horizon.toml")),
     (
         "horizon-true",
-        include_str!("../scenes/stress/horizon-true.toml"),
+        include_str!("../../scenes/stress/horizon-true.toml"),
     ),
-    ("seed-x1", include_str!("../scenes/stress/seed-x1.toml")),
+    ("seed-x1", include_str!("../../scenes/stress/seed-x1.toml")),
     (
         "seed-x1000",
-        include_str!("../scenes/stress/seed-x1000.toml"),
+        include_str!("../../scenes/stress/seed-x1000.toml"),
     ),
     (
         "seed-x0.001",
-        include_str!("../scenes/stress/seed-x0.001.toml"),
+        include_str!("../../scenes/stress/seed-x0.001.toml"),
     ),
-    ("contact", include_str!("../scenes/stress/contact.toml")),
-    ("graze", include_str!("../scenes/stress/graze.toml")),
+    ("contact", include_str!("../../scenes/stress/contact.toml")),
+    ("graze", include_str!("../../scenes/stress/graze.toml")),
 ];
 
 /// A stress scene by name.
 pub fn case(name: &str) -> Option<Scene> {
     let (_, text) = CASES.iter().find(|(n, _)| *n == name)?;
     Some(
-        crate::scene_file::parse(text, &format!("scenes/stress/{name}.toml"))
+        crate::io::scene_file::parse(text, &format!("scenes/stress/{name}.toml"))
             .expect("stress scenes are valid"),
     )
 }
