@@ -3,7 +3,7 @@
 //! offers a true plane, a point and a normal, so the two can be compared.
 
 use crate::ray::Ray;
-use crate::real::{Real, Vector};
+use crate::real::{Real, Vec3Num};
 
 /// The points `X` with `⟨X − P, n⟩ = 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,6 +1,6 @@
 //! A ray: a starting point and a unit direction, `ray(t) = O + d·t`.
 
-use crate::real::{Real, Vector};
+use crate::real::{Real, Vec3Num};
 
 /// A half-line that starts at `origin` and runs along the unit vector `direction`,
 /// computed in precision `T` (float64 unless said otherwise).

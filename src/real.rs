@@ -4,46 +4,70 @@
 //! [`Vector`] the few it needs from a 3-vector; `f32` (with glam's `Vec3`) and
 //! `f64` (with glam's `DVec3`) provide them. Every type of the tracer takes the
 //! precision as a parameter that defaults to `f64`, so `Ray` means `Ray<f64>`.
+//!
+//! The formulas without a branch (the normal, the step off a surface, the half
+//! vector, the mirrored direction, the camera's grid) ask less: only the
+//! arithmetic of [`Num`] and [`Vec3Num`]. Four numbers in SIMD lanes have that
+//! arithmetic too, so the fast engine computes those formulas with the very
+//! bodies the book shows: change one, and both engines change.
 
 use std::fmt::Debug;
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
 use glam::DVec3;
 
-/// A floating-point number the tracer can compute in.
-pub trait Real:
+/// The arithmetic of a formula without a branch: what one number and four
+/// numbers side by side in SIMD lanes both have.
+pub trait Num:
     Copy
-    + Debug
-    + PartialOrd
-    + Send
-    + Sync
-    + 'static
     + Add<Output = Self>
     + Sub<Output = Self>
     + Mul<Output = Self>
     + Div<Output = Self>
     + Neg<Output = Self>
 {
+    /// The number nearest to `x` (in every lane).
+    fn of(x: f64) -> Self;
+    /// Square root.
+    fn sqrt(self) -> Self;
+    /// The larger of two (a NaN gives the other).
+    fn max(self, other: Self) -> Self;
+}
+
+/// A 3-vector of [`Num`]s: the arithmetic of a formula without a branch.
+pub trait Vec3Num:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Neg<Output = Self> + Mul<Self::Num, Output = Self>
+{
+    /// The number type of the components.
+    type Num: Num;
+    /// Dot product, `x·x' + y·y' + z·z'` added in that order.
+    fn dot(self, other: Self) -> Self::Num;
+    /// Squared length.
+    fn length_squared(self) -> Self::Num;
+    /// Euclidean length.
+    fn length(self) -> Self::Num;
+    /// The unit vector in the same direction, `v · (1 / ‖v‖)`.
+    fn normalize(self) -> Self;
+    /// The largest absolute value of a component.
+    fn max_abs(self) -> Self::Num;
+}
+
+/// A floating-point number the tracer can compute in.
+pub trait Real: Num + Debug + PartialOrd + Send + Sync + 'static {
     /// The 3-vector of this precision.
     type Vec3: Vector<Self>;
     /// The unit roundoff u: every basic operation is exact up to a factor (1 ± u).
     const UNIT_ROUNDOFF: Self;
     /// `f32` or `f64`.
     const NAME: &'static str;
-    /// The number nearest to `x`.
-    fn of(x: f64) -> Self;
     /// The same value in float64 (exact).
     fn to_f64(self) -> f64;
-    /// Square root.
-    fn sqrt(self) -> Self;
     /// Absolute value.
     fn abs(self) -> Self;
     /// `self` to the power `e`.
     fn powf(self, e: Self) -> Self;
     /// `self` to a whole power, by repeated multiplication.
     fn powi(self, n: i32) -> Self;
-    /// The larger of two.
-    fn max(self, other: Self) -> Self;
     /// The smaller of two.
     fn min(self, other: Self) -> Self;
     /// 1 with the sign of `self` (+1 for +0).
@@ -53,35 +77,15 @@ pub trait Real:
 }
 
 /// A 3-vector of [`Real`]s: a point, a direction or a colour.
-pub trait Vector<T>:
-    Copy
-    + Debug
-    + PartialEq
-    + Send
-    + Sync
-    + Add<Output = Self>
-    + Sub<Output = Self>
-    + Neg<Output = Self>
-    + Mul<T, Output = Self>
-    + Mul<Self, Output = Self>
-    + AddAssign
+pub trait Vector<T: Num>:
+    Vec3Num<Num = T> + Debug + PartialEq + Send + Sync + Mul<Self, Output = Self> + AddAssign
 {
     /// (0, 0, 0).
     const ZERO: Self;
     /// The vector (x, y, z).
     fn new(x: T, y: T, z: T) -> Self;
-    /// Dot product.
-    fn dot(self, other: Self) -> T;
-    /// Euclidean length.
-    fn length(self) -> T;
-    /// Squared length.
-    fn length_squared(self) -> T;
-    /// The unit vector in the same direction.
-    fn normalize(self) -> Self;
     /// Distance between two points.
     fn distance(self, other: Self) -> T;
-    /// The largest absolute value of a component.
-    fn max_abs(self) -> T;
     /// Each component clamped to [0, 1]; a NaN stays NaN, so that a bug shows
     /// instead of turning black.
     fn clamp01(self) -> Self;
@@ -93,18 +97,27 @@ pub trait Vector<T>:
 
 macro_rules! real {
     ($t:ty, $v:ty, $name:literal) => {
+        impl Num for $t {
+            #[inline(always)]
+            fn of(x: f64) -> $t {
+                x as $t
+            }
+            #[inline(always)]
+            fn sqrt(self) -> $t {
+                <$t>::sqrt(self)
+            }
+            #[inline(always)]
+            fn max(self, other: $t) -> $t {
+                <$t>::max(self, other)
+            }
+        }
+
         impl Real for $t {
             type Vec3 = $v;
             const UNIT_ROUNDOFF: $t = <$t>::EPSILON / 2.0;
             const NAME: &'static str = $name;
-            fn of(x: f64) -> $t {
-                x as $t
-            }
             fn to_f64(self) -> f64 {
                 self as f64
-            }
-            fn sqrt(self) -> $t {
-                <$t>::sqrt(self)
             }
             fn abs(self) -> $t {
                 <$t>::abs(self)
@@ -114,9 +127,6 @@ macro_rules! real {
             }
             fn powi(self, n: i32) -> $t {
                 <$t>::powi(self, n)
-            }
-            fn max(self, other: $t) -> $t {
-                <$t>::max(self, other)
             }
             fn min(self, other: $t) -> $t {
                 <$t>::min(self, other)
@@ -133,28 +143,37 @@ macro_rules! real {
             }
         }
 
+        impl Vec3Num for $v {
+            type Num = $t;
+            #[inline(always)]
+            fn dot(self, other: $v) -> $t {
+                <$v>::dot(self, other)
+            }
+            #[inline(always)]
+            fn length_squared(self) -> $t {
+                <$v>::length_squared(self)
+            }
+            #[inline(always)]
+            fn length(self) -> $t {
+                <$v>::length(self)
+            }
+            #[inline(always)]
+            fn normalize(self) -> $v {
+                <$v>::normalize(self)
+            }
+            #[inline(always)]
+            fn max_abs(self) -> $t {
+                self.abs().max_element()
+            }
+        }
+
         impl Vector<$t> for $v {
             const ZERO: $v = <$v>::ZERO;
             fn new(x: $t, y: $t, z: $t) -> $v {
                 <$v>::new(x, y, z)
             }
-            fn dot(self, other: $v) -> $t {
-                <$v>::dot(self, other)
-            }
-            fn length(self) -> $t {
-                <$v>::length(self)
-            }
-            fn length_squared(self) -> $t {
-                <$v>::length_squared(self)
-            }
-            fn normalize(self) -> $v {
-                <$v>::normalize(self)
-            }
             fn distance(self, other: $v) -> $t {
                 <$v>::distance(self, other)
-            }
-            fn max_abs(self) -> $t {
-                self.abs().max_element()
             }
             fn clamp01(self) -> $v {
                 let clip = |c: $t| if c.is_nan() { c } else { c.clamp(0.0, 1.0) };

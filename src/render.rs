@@ -14,7 +14,7 @@ use crate::aov::{FirstHit, Frame, Packets, PixelRecord, Rays};
 use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::ray::Ray;
-use crate::real::{Precision, Real, Vector};
+use crate::real::{Precision, Real, Vec3Num, Vector};
 use crate::samples::stratified;
 use crate::scene::{nearest_hit, Hit, Light, Object, Role, Scene};
 use crate::shade::blinn_phong::{self, Terms, Viewer};

@@ -5,8 +5,8 @@
 use crate::camera::{Camera, Screen};
 use crate::plane::Plane;
 use crate::ray::Ray;
-use crate::real::{Real, Vector};
-use crate::sphere::{Method, Sphere};
+use crate::real::{Real, Vec3Num, Vector};
+use crate::sphere::{outward_normal, Method, Sphere};
 use crate::stages::Stages;
 use crate::Vec3;
 
@@ -208,8 +208,8 @@ impl<T: Real> Object<T> {
     #[inline]
     pub fn project(&self, p: T::Vec3) -> T::Vec3 {
         match &self.shape {
-            Shape::Sphere(s) => s.center + (p - s.center).normalize() * s.radius,
-            Shape::Plane(pl) => p - pl.normal * (p - pl.point).dot(pl.normal),
+            Shape::Sphere(s) => on_sphere(s.center, outward_normal(p, s.center), s.radius),
+            Shape::Plane(pl) => on_plane(p, pl.point, pl.normal),
         }
     }
 
@@ -220,7 +220,7 @@ impl<T: Real> Object<T> {
     #[inline]
     pub fn surface_point(&self, p: T::Vec3, normal: T::Vec3) -> T::Vec3 {
         match &self.shape {
-            Shape::Sphere(s) => s.center + normal * s.radius,
+            Shape::Sphere(s) => on_sphere(s.center, normal, s.radius),
             Shape::Plane(_) => self.project(p),
         }
     }
@@ -235,6 +235,20 @@ impl<T: Real> Object<T> {
             Shape::Plane(pl) => pl.point.max_abs(),
         }
     }
+}
+
+/// The point of the sphere of `center` and `radius` in the direction of the unit
+/// `normal`: `C + N·r`. (For any [`Vec3Num`], as the fast engine computes it.)
+#[inline(always)]
+pub fn on_sphere<V: Vec3Num>(center: V, normal: V, radius: V::Num) -> V {
+    center + normal * radius
+}
+
+/// The point of the plane through `point` with unit `normal` nearest to `p`:
+/// `p − n·⟨p − P, n⟩`. (For any [`Vec3Num`], as the fast engine computes it.)
+#[inline(always)]
+pub fn on_plane<V: Vec3Num>(p: V, point: V, normal: V) -> V {
+    p - normal * (p - point).dot(normal)
 }
 
 impl<T: Real> Object<T> {

@@ -218,7 +218,7 @@ fn recast(settings: Settings) -> Recast {
             };
             r.checked += 1;
             r.inside += usize::from(surface_distance(object, shifted) <= 0.0);
-            r.rehit += usize::from(cast(reflect::<f64>(ray.direction, hit.normal)).is_some());
+            r.rehit += usize::from(cast(reflect(ray.direction, hit.normal)).is_some());
             let facing = to_light.dot(hit.normal);
             if facing < 0.0 && cast(to_light).is_none() {
                 r.dark_leaks += 1;

@@ -20,7 +20,7 @@
 use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
-use crate::real::{Real, Vector};
+use crate::real::{Num, Real, Vec3Num, Vector};
 
 /// A [`Real`] that the fast engine can put four to a SIMD register: the lane
 /// type of its precision. (The book's number trait knows nothing of lanes.)
@@ -68,18 +68,7 @@ pub fn convert<T: Laned, L: Laned>(l: T::Lanes) -> L::Lanes {
 
 /// Four numbers of precision `T` computed together.
 pub trait Lanes<T: Real>:
-    Copy
-    + Debug
-    + Send
-    + Sync
-    + Add<Output = Self>
-    + Sub<Output = Self>
-    + Mul<Output = Self>
-    + Div<Output = Self>
-    + Neg<Output = Self>
-    + BitAnd<Output = Self>
-    + BitOr<Output = Self>
-    + Not<Output = Self>
+    Num + Debug + Send + Sync + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self>
 {
     /// The same number in every lane.
     fn splat(x: T) -> Self;
@@ -87,12 +76,8 @@ pub trait Lanes<T: Real>:
     fn from_array(a: [T; WIDTH]) -> Self;
     /// The lanes as an array.
     fn to_array(self) -> [T; WIDTH];
-    /// Square root of each lane.
-    fn sqrt(self) -> Self;
     /// The smaller of two, lane by lane (as [`Real::min`]: a NaN gives the other).
     fn min(self, other: Self) -> Self;
-    /// The larger of two, lane by lane (as [`Real::max`]: a NaN gives the other).
-    fn max(self, other: Self) -> Self;
     /// The smaller of two, lane by lane, where neither is a NaN (a lane with a NaN
     /// may come out as either): one instruction, where [`Lanes::min`] takes four.
     fn fast_min(self, other: Self) -> Self;
@@ -119,6 +104,21 @@ pub trait Lanes<T: Real>:
 
 macro_rules! lanes {
     ($t:ty, $w:ty, $bits:ty) => {
+        impl Num for $w {
+            #[inline(always)]
+            fn of(x: f64) -> Self {
+                <$w>::splat(x as $t)
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                <$w>::sqrt(self)
+            }
+            #[inline(always)]
+            fn max(self, other: Self) -> Self {
+                <$w>::max(self, other)
+            }
+        }
+
         impl Lanes<$t> for $w {
             #[inline(always)]
             fn splat(x: $t) -> Self {
@@ -133,16 +133,8 @@ macro_rules! lanes {
                 <$w>::to_array(self)
             }
             #[inline(always)]
-            fn sqrt(self) -> Self {
-                <$w>::sqrt(self)
-            }
-            #[inline(always)]
             fn min(self, other: Self) -> Self {
                 <$w>::min(self, other)
-            }
-            #[inline(always)]
-            fn max(self, other: Self) -> Self {
-                <$w>::max(self, other)
             }
             #[inline(always)]
             fn fast_min(self, other: Self) -> Self {
@@ -302,6 +294,28 @@ impl Not for F64x4 {
     }
 }
 
+impl Num for F64x4 {
+    #[inline(always)]
+    fn of(x: f64) -> Self {
+        F64x4([x; WIDTH])
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        self.map(f64::sqrt)
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        self.zip(o, |a, b| {
+            let max = if a > b { a } else { b };
+            if b.is_nan() {
+                a
+            } else {
+                max
+            }
+        })
+    }
+}
+
 impl Lanes<f64> for F64x4 {
     #[inline(always)]
     fn splat(x: f64) -> Self {
@@ -316,10 +330,6 @@ impl Lanes<f64> for F64x4 {
         self.0
     }
     #[inline(always)]
-    fn sqrt(self) -> Self {
-        self.map(f64::sqrt)
-    }
-    #[inline(always)]
     fn min(self, o: Self) -> Self {
         // The processor's minimum (`a < b ? a : b`), and the other where `o` is a
         // NaN: Rust's `f64::min` for every NaN.
@@ -329,17 +339,6 @@ impl Lanes<f64> for F64x4 {
                 a
             } else {
                 min
-            }
-        })
-    }
-    #[inline(always)]
-    fn max(self, o: Self) -> Self {
-        self.zip(o, |a, b| {
-            let max = if a > b { a } else { b };
-            if b.is_nan() {
-                a
-            } else {
-                max
             }
         })
     }
@@ -517,21 +516,45 @@ impl<T: Laned> Neg for V3<T> {
     }
 }
 
-/// Component by component (colours).
-impl<T: Laned> Mul for V3<T> {
+/// Each component times the lane's number.
+impl<T: Laned> Mul<T::Lanes> for V3<T> {
     type Output = V3<T>;
     #[inline(always)]
-    fn mul(self, o: V3<T>) -> V3<T> {
-        V3::new(self.x * o.x, self.y * o.y, self.z * o.z)
+    fn mul(self, s: T::Lanes) -> V3<T> {
+        V3::new(self.x * s, self.y * s, self.z * s)
     }
 }
 
 impl<T: Laned> V3<T> {
-    /// Each component times the lane's number (`Mul<T::Lanes>` would clash with
-    /// the component-wise product for the compiler, so it has a name).
+    /// `self * s`, by name.
     #[inline(always)]
     pub fn scale(self, s: T::Lanes) -> V3<T> {
-        V3::new(self.x * s, self.y * s, self.z * s)
+        self * s
+    }
+}
+
+/// The arithmetic of the book's formulas without a branch, four vectors at once.
+impl<T: Laned> Vec3Num for V3<T> {
+    type Num = T::Lanes;
+    #[inline(always)]
+    fn dot(self, o: V3<T>) -> T::Lanes {
+        V3::dot(self, o)
+    }
+    #[inline(always)]
+    fn length_squared(self) -> T::Lanes {
+        V3::length_squared(self)
+    }
+    #[inline(always)]
+    fn length(self) -> T::Lanes {
+        V3::length(self)
+    }
+    #[inline(always)]
+    fn normalize(self) -> V3<T> {
+        V3::normalize(self)
+    }
+    #[inline(always)]
+    fn max_abs(self) -> T::Lanes {
+        V3::max_abs(self)
     }
 }
 
@@ -594,7 +617,7 @@ mod tests {
         let b = F64x4::from_array([2.0, f64::NAN, 1.0, f64::NAN]);
         let (lo, hi) = (
             Lanes::<f64>::min(a, b).to_array(),
-            Lanes::<f64>::max(a, b).to_array(),
+            <F64x4 as Num>::max(a, b).to_array(),
         );
         let (a, b) = (a.to_array(), b.to_array());
         for i in 0..3 {

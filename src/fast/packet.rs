@@ -50,15 +50,19 @@ use std::borrow::Cow;
 
 use crate::accel::{Accel, EVERY};
 use crate::aov::{PixelRecord, Rays};
+use crate::camera::lerp_on_grid;
 use crate::fast::lanes::{components, convert, each, powi, F64s, Laned, Lanes, ALL, V3, WIDTH};
 use crate::fast::masks::{TileMasks, TILE};
 use crate::fast::walk::PacketSearch;
-use crate::real::Vector;
+use crate::real::{Num, Vector};
 use crate::render::{direction_colour, Settings, Tracer, HALF_STEP};
 use crate::samples::stratified;
+use crate::scene::{on_plane, on_sphere};
 use crate::scene::{Light, Object, Scene, Shape};
-use crate::shade::blinn_phong::{whole_exponent, Viewer};
-use crate::shade::shadow::{Offset, AUTO_FACTOR};
+use crate::shade::blinn_phong::{factors, whole_exponent, Viewer};
+use crate::shade::reflection::reflect;
+use crate::shade::shadow::{step_out, Offset};
+use crate::sphere::outward_normal;
 use crate::sphere::Method;
 use crate::Vec3;
 
@@ -633,15 +637,10 @@ impl<T: Laned> Fast<T> {
     fn rays_through(&self, rows: [f64; WIDTH], cols: [f64; WIDTH]) -> Packet<T> {
         let camera = &self.book.camera;
         let s = &camera.screen;
-        // `from + i·(to − from)/(n − 1)`, as the camera's grid.
+        // The camera's grid, four samples at once.
         let grid = |from: f64, to: f64, at: [f64; WIDTH], n: u32| {
-            let (from, to) = (T::of(from), T::of(to));
-            if n < 2 {
-                return T::Lanes::splat(from);
-            }
-            T::Lanes::splat(from)
-                + T::Lanes::from_array(each(|i| T::of(at[i]))) * T::Lanes::splat(to - from)
-                    / T::Lanes::splat(T::of(f64::from(n - 1)))
+            let (from, to) = (T::Lanes::splat(T::of(from)), T::Lanes::splat(T::of(to)));
+            lerp_on_grid(from, to, T::Lanes::from_array(each(|i| T::of(at[i]))), n)
         };
         let x = grid(s.left, s.right, cols, camera.width);
         let y = grid(s.top, s.bottom, rows, camera.height);
@@ -772,10 +771,9 @@ impl<T: Laned> Fast<T> {
                 traced.colour,
             );
             weight = on.select(weight * object.reflection, weight);
-            let d = ray.direction;
             ray = Packet {
                 origin: shifted,
-                direction: d - normal.scale(T::Lanes::splat(T::of(2.0)) * d.dot(normal)),
+                direction: reflect(ray.direction, normal),
             };
             // Early stop: nothing the rest of the path adds can change the pixel.
             let left = (segments - segment - 1) as usize;
@@ -874,6 +872,13 @@ impl<T: Laned> Fast<T> {
     }
     /// Distance along each ray to `object`, and the mask of the lanes that hit it,
     /// by the rules of [`Object::intersect`].
+    ///
+    /// The one formula of the book written a second time here (the others the
+    /// packet computes with the book's own generic functions): where one ray
+    /// branches on Δ and on the signs of its roots, four rays need masks, and the
+    /// early outs that skip the square root and the division when all four miss
+    /// are most of the packets' gain on shadow and reflected rays (chapter 10).
+    /// `tests/speed.rs` holds the two to the same bits.
     #[inline(always)]
     fn hits(&self, object: &Shape4<T>, ray: &Packet<T>) -> (T::Lanes, T::Lanes) {
         let zero = T::Lanes::splat(T::of(0.0));
@@ -939,7 +944,7 @@ impl<T: Laned> Fast<T> {
     ) -> V3<T> {
         let shape = &object.shape;
         let spheres = shape.spheres & alive;
-        let sphere = || (point - shape.point).normalize();
+        let sphere = || outward_normal(point, shape.point);
         if spheres == alive {
             return sphere();
         }
@@ -965,21 +970,19 @@ impl<T: Laned> Fast<T> {
             Offset::Auto => {
                 let shape = &object.shape;
                 let spheres = shape.spheres & alive;
-                let on_sphere = || shape.point + normal.scale(object.radius);
+                let sphere = || on_sphere(shape.point, normal, object.radius);
                 let on_surface = if spheres == alive {
-                    on_sphere()
+                    sphere()
                 } else {
-                    let n = shape.normal;
-                    let on_plane = point - n.scale((point - shape.point).dot(n));
+                    let plane = on_plane(point, shape.point, shape.normal);
                     if spheres == 0 {
-                        on_plane
+                        plane
                     } else {
-                        V3::select(T::Lanes::mask(spheres), on_sphere(), on_plane)
+                        V3::select(T::Lanes::mask(spheres), sphere(), plane)
                     }
                 };
-                let scale = object.magnitude.max(on_surface.max_abs());
-                let bound = T::Lanes::splat(T::of(AUTO_FACTOR) * T::UNIT_ROUNDOFF) * scale;
-                on_surface + normal.scale(bound)
+                let u = T::Lanes::splat(T::UNIT_ROUNDOFF);
+                step_out(on_surface, normal, object.magnitude, u)
             }
         }
     }
@@ -994,9 +997,7 @@ impl<T: Laned> Fast<T> {
         to_light: V3<T>,
         to_viewer: V3<T>,
     ) -> Terms4<T> {
-        let l_dot_n = to_light.dot(normal);
-        let half = (to_light + to_viewer).normalize();
-        let n_dot_h = normal.dot(half).max(T::Lanes::splat(T::of(0.0)));
+        let (l_dot_n, n_dot_h) = factors(normal, to_light, to_viewer);
         // blinn_phong::power: repeated squaring for a whole exponent, powf otherwise.
         let mut highlight = powi::<T>(n_dot_h, object.whole);
         if object.fractional & lit != 0 {

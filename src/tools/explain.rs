@@ -14,7 +14,7 @@ use serde::Serialize;
 use crate::aov::Rays;
 use crate::io::output::to_byte;
 use crate::ray::Ray;
-use crate::real::{Real, Vector};
+use crate::real::{Real, Vec3Num, Vector};
 use crate::render::{direction_colour, End, Observer, Settings, Tracer};
 use crate::scene::{nearest_hit, Hit, Object, Role, Scene, Shape};
 use crate::shade::blinn_phong::{Terms, Viewer};
