@@ -318,13 +318,14 @@ fn without_shadow_every_hit_is_plain_blinn_phong_even_where_it_is_negative() {
             let shifted = step_off(point, hit.normal, object, settings.offset);
             let to_light = (scene.light.position - shifted).normalize();
             let to_camera = (scene.camera - point).normalize();
-            let expected = raystep::shade::blinn_phong::illuminate(
+            let expected = raystep::shade::blinn_phong::terms(
                 &object.material,
                 &scene.light,
                 hit.normal,
                 to_light,
                 to_camera,
             )
+            .sum()
             .clamp(Vec3::ZERO, Vec3::ONE);
             let got = Vec3::from(p.colour.map(f64::from));
             assert!(

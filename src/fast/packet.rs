@@ -64,6 +64,7 @@ use crate::shade::reflection::reflect;
 use crate::shade::shadow::{step_out, Offset};
 use crate::sphere::outward_normal;
 use crate::sphere::Method;
+use crate::stages::Stage;
 use crate::Vec3;
 
 // A packet's pixels must share a tile, so that they share its mask.
@@ -108,8 +109,10 @@ impl<T: Laned> Fast<T> {
             settings.spp,
             crate::samples::MAX_SPP
         );
-        // Packets search a short list by bit masks, a long one through the BVH.
-        let packets = book.bvh.is_some() || book.objects.len() <= MAX_OBJECTS;
+        // Packets search a short list by bit masks, a long one through the BVH;
+        // a stage the packet loop does not compute is left to the book's engine.
+        let known = Stage::ALL.iter().all(|&s| !settings.stages.is_on(s) || knows(s));
+        let packets = known && (book.bvh.is_some() || book.objects.len() <= MAX_OBJECTS);
         let masks = match settings.accel {
             Accel::Off => TileMasks::none(),
             Accel::Auto | Accel::Bvh if packets => TileMasks::new(&book.camera, &book.objects),
@@ -139,6 +142,21 @@ impl<T: Laned> Fast<T> {
             book,
         }
     }
+}
+
+/// Does the packet loop compute `stage`? A stage added to the book after it is
+/// not listed here, and a render with it on falls back to the book's engine (as
+/// `raystep bench` then says) until the packet loop learns it.
+fn knows(stage: Stage) -> bool {
+    matches!(
+        stage,
+        Stage::Rays
+            | Stage::Intersection
+            | Stage::Shadow
+            | Stage::BlinnPhong
+            | Stage::Reflection
+            | Stage::Plane
+    )
 }
 
 /// Does this processor have AVX? (Asked once; false off x86-64.)

@@ -15,19 +15,6 @@ pub enum Viewer {
 }
 
 // ANCHOR: illuminate
-/// The light a point reflects towards the viewer: the sum of its three
-/// [`Terms`].
-#[inline]
-pub fn illuminate<T: Real>(
-    material: &Material<T>,
-    light: &Light<T>,
-    normal: T::Vec3,
-    to_light: T::Vec3,
-    to_viewer: T::Vec3,
-) -> T::Vec3 {
-    terms(material, light, normal, to_light, to_viewer).sum()
-}
-
 /// The three terms of Blinn-Phong at one point, and the factors they come from
 /// (what `raystep explain` prints and the `diffuse` and `specular` buffers hold).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -142,7 +129,7 @@ mod tests {
     #[test]
     fn head_on_light_and_viewer_give_every_term_in_full() {
         let n = Vec3::Z;
-        let c = illuminate(&material(0.1, 0.5, 0.25), &WHITE, n, n, n);
+        let c = terms(&material(0.1, 0.5, 0.25), &WHITE, n, n, n).sum();
         assert!((c - Vec3::splat(0.85)).abs().max_element() < 1e-15);
     }
 
@@ -151,14 +138,14 @@ mod tests {
         let n = Vec3::Z;
         let l = Vec3::new(0.6, 0.0, 0.8);
         // No specular, so only ambient + kd·(L·N) remains.
-        let c = illuminate(&material(0.0, 1.0, 0.0), &WHITE, n, l, n);
+        let c = terms(&material(0.0, 1.0, 0.0), &WHITE, n, l, n).sum();
         assert!((c.x - 0.8).abs() < 1e-15);
     }
 
     #[test]
     fn a_half_vector_behind_the_surface_gives_no_highlight_and_no_nan() {
         let n = Vec3::Z;
-        let c = illuminate(&material(0.0, 0.0, 1.0), &WHITE, n, -Vec3::X, -Vec3::Z);
+        let c = terms(&material(0.0, 0.0, 1.0), &WHITE, n, -Vec3::X, -Vec3::Z).sum();
         assert_eq!(c, Vec3::ZERO);
     }
 }
