@@ -111,7 +111,9 @@ impl<T: Laned> Fast<T> {
         );
         // Packets search a short list by bit masks, a long one through the BVH;
         // a stage the packet loop does not compute is left to the book's engine.
-        let known = Stage::ALL.iter().all(|&s| !settings.stages.is_on(s) || knows(s));
+        let known = Stage::ALL
+            .iter()
+            .all(|&s| !settings.stages.is_on(s) || knows(s));
         let packets = known && (book.bvh.is_some() || book.objects.len() <= MAX_OBJECTS);
         let masks = match settings.accel {
             Accel::Off => TileMasks::none(),

@@ -101,7 +101,11 @@ pub fn power<T: Real>(x: T, e: T) -> T {
 #[inline]
 pub fn whole_exponent<T: Real>(e: T) -> Option<u32> {
     let e = e.to_f64();
-    (e.fract() == 0.0 && (0.0..=256.0).contains(&e)).then_some(e as u32)
+    // `as` saturates (a NaN or a negative number gives 0), so `n` is `e` exactly
+    // when `e` is a whole number from 0 to 2³² − 1. (A conversion and a compare:
+    // `fract` is a call into libm on a plain x86-64 build.)
+    let n = e as u32;
+    (f64::from(n) == e && n <= 256).then_some(n)
 }
 
 #[cfg(test)]

@@ -234,7 +234,8 @@ impl Report {
                 "avx" => "four rays at once, the AVX build (4 float64 lanes to a register)",
                 "baseline" =>
                     "four rays at once, the baseline build (2 float64 lanes to a register)",
-                _ => "off: the fast engine left this scene to the book's engine, one ray at a \
+                _ =>
+                    "off: the fast engine left this scene to the book's engine, one ray at a \
                       time (more than 64 objects without a BVH, or a stage it does not know)",
             }
         ));
