@@ -192,6 +192,16 @@ fn fixtures() -> &'static Path {
                 .copy_from_slice(&1_999_999i32.to_le_bytes());
         }
         std::fs::write(at("huge-header.exr"), huge_header).unwrap();
+        // Flat grey, and the same with a NaN, an infinity and a -infinity.
+        let grey = |x: usize, y: usize| match (x, y) {
+            (3, 2) => (f32::NAN, 0.5, 0.5),
+            (4, 2) => (f32::INFINITY, 0.5, 0.5),
+            (5, 2) => (0.5, f32::NEG_INFINITY, 0.5),
+            _ => (0.5, 0.5, 0.5),
+        };
+        exr::prelude::write_rgb_file(at("flat.exr"), 8, 4, |_, _| (0.5f32, 0.5f32, 0.5f32))
+            .unwrap();
+        exr::prelude::write_rgb_file(at("non-finite.exr"), 8, 4, grey).unwrap();
         dir
     })
     .path()
@@ -516,4 +526,90 @@ fn chapter_1_quotes_the_message_raystep_gives() {
     let quoted = &quoted[..quoted.find("```").unwrap()];
     let out = raystep(root, &["check", "tests/hostile/scenes/unknown-radus.toml"]);
     assert_eq!(quoted, String::from_utf8_lossy(&out.stderr));
+}
+
+#[test]
+fn a_plane_normal_of_any_length_becomes_a_unit_vector() {
+    // The squared length of the first is subnormal, of the second zero: both were
+    // normalised badly (to length 1.011) or refused.
+    for (name, expected) in [
+        (
+            "plane-subnormal-normal.toml",
+            [0.09950371902099892, 0.9950371902099893, 0.0],
+        ),
+        ("plane-underflowing-normal.toml", [0.0, 1.0, 0.0]),
+    ] {
+        let path = corpus().join("scenes").join(name);
+        let scene = raystep::io::scene_file::load(&path).unwrap();
+        let raystep::scene::Shape::Plane(plane) = scene.objects.last().unwrap().shape else {
+            panic!("{name}: the last object is the plane");
+        };
+        assert!(
+            (plane.normal.length() - 1.0).abs() <= 1e-15,
+            "{name}: {:?}",
+            plane.normal
+        );
+        assert_eq!(plane.normal.to_array(), expected, "{name}");
+    }
+}
+
+#[test]
+fn output_that_cannot_be_written_is_an_error_and_a_closed_pipe_is_not() {
+    use std::io::Read;
+    use std::process::Stdio;
+    let full = Path::new("/dev/full");
+    if !full.exists() {
+        eprintln!("no /dev/full here: the full-device cases are skipped");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("ok.toml"), OK_SCENE).unwrap();
+    for args in [
+        &["generate", "spheres", "--count", "100"][..],
+        &["check", "ok.toml"],
+        &["explain", "ok.toml", "--pixel", "1,1", "--json"],
+        &["explain", "ok.toml", "--pixel", "1,1"],
+        &[
+            "render", "ok.toml", "--width", "20", "--height", "10", "--out", "out",
+        ],
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_raystep"))
+            .args(args)
+            .current_dir(dir.path())
+            .stdout(std::fs::File::create(full).unwrap())
+            .output()
+            .unwrap();
+        let said = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{args:?} into a full device: {said}"
+        );
+        assert!(
+            said.contains("cannot write standard output: No space left on device"),
+            "{args:?}: {said}"
+        );
+        // The render's report could not be given: its files are not committed.
+        assert_eq!(
+            names(dir.path()),
+            vec!["ok.toml".to_string()],
+            "{args:?} wrote"
+        );
+    }
+    // A reader that stops early (`| head -1`) is no error: exit 0, nothing said.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_raystep"))
+        .args(["generate", "spheres", "--count", "100000"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = [0u8; 64];
+    child.stdout.take().unwrap().read_exact(&mut first).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "a closed pipe");
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }

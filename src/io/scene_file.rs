@@ -598,15 +598,24 @@ impl PlaneKeys {
             )?)),
             (None, Some(p), Some(n)) => {
                 let normal = point(n, &format!("{at}, normal"))?;
-                if normal.length_squared() == 0.0 || !normal.length_squared().is_finite() {
+                let largest = normal.abs().max_element();
+                if largest == 0.0 || !normal.length_squared().is_finite() {
                     return Err(format!(
                         "{at}, normal: must be a non-zero vector of moderate size"
                     ));
                 }
+                // A normal so short that its squared length is subnormal or zero (say
+                // [1e-162, 1e-161, 0]) has too few bits left in that square to be
+                // normalised: its largest component is brought to 1 first.
+                let normal = if normal.length_squared() < f64::MIN_POSITIVE {
+                    normal / largest
+                } else {
+                    normal
+                };
+                let normal = normal.normalize();
                 // Any point of the plane names it; keep the one nearest the origin,
                 // so that the numbers the plane is computed from are no larger than
                 // the plane's distance from the origin.
-                let normal = normal.normalize();
                 let anchor = point(p, &format!("{at}, point"))?;
                 Ok(Shape::Plane(Plane {
                     point: normal * anchor.dot(normal),

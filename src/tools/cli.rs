@@ -20,13 +20,33 @@ use crate::shade::shadow::Offset;
 use crate::sphere::Method;
 use crate::stages::{Engine, Stage, Stages};
 
-/// Print a line on stdout. A closed stdout (`raystep ... | head -1`) is not an
-/// error worth stopping a render for, and must not panic as `println!` does.
+/// Print a line on stdout, returning from the function with an error if it
+/// cannot be written ([`say_line`]).
 macro_rules! say {
-    ($($arg:tt)*) => {{
-        use std::io::Write;
-        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
-    }};
+    ($($arg:tt)*) => {
+        say_line(format_args!($($arg)*))?
+    };
+}
+
+/// Write `text` and a newline to standard output. A closed pipe (`raystep ... |
+/// head -1`) ends the output quietly, as the reader has stopped reading; any other
+/// failure (a full disk, `> /dev/full`) is an error, so that a command whose
+/// output was lost or cut never exits 0.
+fn say_line(text: std::fmt::Arguments) -> Result<(), Error> {
+    write_stdout(format!("{text}\n").as_bytes())
+}
+
+/// Write `bytes` to standard output, by the rules of [`say_line`].
+fn write_stdout(bytes: &[u8]) -> Result<(), Error> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(bytes).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Error::Output {
+            path: "standard output".into(),
+            message: e.to_string(),
+        }),
+        _ => Ok(()),
+    }
 }
 
 /// raystep: a ray tracer that teaches ray tracing one step at a time.
@@ -348,16 +368,12 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Some(Command::Accuracy(args)) => accuracy(&args),
         Some(Command::Bench(args)) => bench(args),
         Some(Command::Chart(args)) => chart(args),
-        Some(Command::Generate(args)) => {
-            match args.what {
-                Generated::Spheres { count, seed } => {
-                    use std::io::Write;
-                    let text = crate::tools::generate::spheres_toml(count as usize, seed);
-                    let _ = std::io::stdout().lock().write_all(text.as_bytes());
-                }
+        Some(Command::Generate(args)) => match args.what {
+            Generated::Spheres { count, seed } => {
+                let text = crate::tools::generate::spheres_toml(count as usize, seed);
+                write_stdout(text.as_bytes())
             }
-            Ok(())
-        }
+        },
     }
 }
 
@@ -585,15 +601,14 @@ fn write(
         .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
         .collect();
     bar.suspend(|| {
-        say!(
+        say_line(format_args!(
             "  {:<28} {}   render {:.3} s, write {:.3} s",
             format!("{}/", dir.display()),
             names.join(" "),
             render_seconds,
             write_seconds
-        )
-    });
-    Ok(())
+        ))
+    })
 }
 
 fn bench(mut args: BenchArgs) -> Result<(), Error> {
@@ -761,6 +776,14 @@ fn diff(args: &DiffArgs) -> Result<(), Error> {
         d.saturated.0,
         d.saturated.1
     );
+    if d.non_finite != (0, 0) {
+        say!(
+            "  not finite (inf or NaN):   {} and {} pixels (a pixel finite in one file and \
+             not in the other differs; the root mean square is over channels finite in both)",
+            d.non_finite.0,
+            d.non_finite.1
+        );
+    }
     Ok(())
 }
 

@@ -16,10 +16,25 @@ pub struct Difference {
     pub largest: f32,
     /// Where it is: (row, column).
     pub largest_at: (usize, usize),
-    /// Root mean square difference over every channel of every pixel.
+    /// Root mean square difference over every channel of every pixel where both
+    /// images hold a finite number.
     pub rmse: f64,
     /// Pixels with some channel at 1 or more (clipped), in each image.
     pub saturated: (usize, usize),
+    /// Pixels with some channel infinite or NaN, in each image.
+    pub non_finite: (usize, usize),
+}
+
+/// How far apart two channels are: `|p − q|` where both are finite, 0 where both
+/// are the same infinity or both NaN, and infinitely far where only one is finite
+/// (or they are different infinities): a NaN where the other image has a number
+/// is a difference, not an equality.
+fn channel_difference(p: f32, q: f32) -> f32 {
+    match (p.is_finite(), q.is_finite()) {
+        (true, true) => (p - q).abs(),
+        _ if p == q || (p.is_nan() && q.is_nan()) => 0.0,
+        _ => f32::INFINITY,
+    }
 }
 
 /// Compare two RGB images of `width` columns, pixel by pixel.
@@ -32,11 +47,19 @@ pub fn compare(a: &[[f32; 3]], b: &[[f32; 3]], width: usize) -> Difference {
         largest_at: (0, 0),
         rmse: 0.0,
         saturated: (0, 0),
+        non_finite: (0, 0),
     };
-    let mut squares = 0.0f64;
+    let (mut squares, mut finite) = (0.0f64, 0usize);
     for (i, (p, q)) in a.iter().zip(b).enumerate() {
-        let worst = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max);
-        squares += (0..3).map(|c| f64::from(p[c] - q[c]).powi(2)).sum::<f64>();
+        let worst = (0..3)
+            .map(|c| channel_difference(p[c], q[c]))
+            .fold(0.0, f32::max);
+        for c in (0..3).filter(|&c| p[c].is_finite() && q[c].is_finite()) {
+            squares += f64::from(p[c] - q[c]).powi(2);
+            finite += 1;
+        }
+        d.non_finite.0 += usize::from(p.iter().any(|c| !c.is_finite()));
+        d.non_finite.1 += usize::from(q.iter().any(|c| !c.is_finite()));
         if worst > 1.0 / 255.0 {
             d.over_one_step += 1;
         }
@@ -47,7 +70,7 @@ pub fn compare(a: &[[f32; 3]], b: &[[f32; 3]], width: usize) -> Difference {
         d.saturated.0 += usize::from(p.iter().any(|&c| c >= 1.0));
         d.saturated.1 += usize::from(q.iter().any(|&c| c >= 1.0));
     }
-    d.rmse = (squares / (3 * a.len().max(1)) as f64).sqrt();
+    d.rmse = (squares / finite.max(1) as f64).sqrt();
     d
 }
 
@@ -124,5 +147,28 @@ mod tests {
         assert_eq!(d.saturated, (1, 1));
         let expected = ((0.001f64.powi(2) + 0.1f64.powi(2) + 0.3f64.powi(2)) / 12.0).sqrt();
         assert!((d.rmse - expected).abs() < 1e-6, "{}", d.rmse);
+        assert_eq!(d.non_finite, (0, 0));
+    }
+
+    #[test]
+    fn a_nan_or_an_infinity_beside_a_number_is_a_difference() {
+        let a = [
+            [0.5, 0.5, 0.5],
+            [f32::NAN, 0.0, 0.0],
+            [f32::INFINITY, 0.0, 0.0],
+        ];
+        let b = [[0.5, 0.5, 0.5], [0.2, 0.0, 0.0], [f32::INFINITY, 0.0, 0.0]];
+        let d = compare(&a, &b, 3);
+        assert_eq!(
+            d.over_one_step, 1,
+            "the NaN pixel differs, the same infinity not"
+        );
+        assert_eq!(d.largest, f32::INFINITY);
+        assert_eq!(d.largest_at, (0, 1));
+        assert_eq!(d.non_finite, (2, 1));
+        assert!(d.rmse.is_finite() && d.rmse == 0.0, "{}", d.rmse);
+        // Both NaN: the same.
+        let d = compare(&[[f32::NAN; 3]], &[[f32::NAN; 3]], 1);
+        assert_eq!((d.over_one_step, d.non_finite), (0, (1, 1)));
     }
 }
