@@ -20,7 +20,8 @@
 //! widened by a relative 1e-9, far more than their rounding, then widened once
 //! more and kept in float32, rounded outwards ([`Bvh::build`]): the one-ray walk
 //! tests them in float64, and four rays test them in float32, half the work of
-//! float64 lanes, unless a ray starts too far out (`Bvh::enter_packet`). A node is
+//! float64 lanes, unless a ray starts too far out (`Bvh::enter_packet`, in
+//! `src/fast/walk.rs`). A node is
 //! 32 bytes, two to a cache line.
 
 use crate::ray::Ray;
@@ -67,7 +68,7 @@ pub struct Bvh {
 /// How much farther than their float64 boxes the stored boxes reach, in units of
 /// float32's unit roundoff times [`Bvh::fast_reach`]: enough that a float32 box
 /// test of a ray from within that reach never misses a box the exact ray enters
-/// (see [`Bvh::enter_packet`]).
+/// (see `Bvh::enter_packet`, in `src/fast/walk.rs`).
 const FAST_PAD: f64 = 32.0;
 
 /// A sphere while the tree is built: its index, box and box centre.
@@ -115,7 +116,7 @@ impl Bvh {
         });
         let reach = 2.0 * largest;
         // Below float32's normal numbers the rounding of an origin is not relative
-        // (and the bound of `enter_packet` fails): such a tree is walked in float64.
+        // (and the bound of `Bvh::enter_packet`, in src/fast/walk.rs, fails): such a tree is walked in float64.
         let fast_reach = if largest < 1e-30 { -1.0 } else { below(reach) };
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(2 * items.len() / LEAF + 1),

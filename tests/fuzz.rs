@@ -22,11 +22,13 @@
 //! The loader must not panic, and when it refuses a file its message must say
 //! something and name the file. A scene it accepts is rendered under raystep's
 //! defaults, the `rays` stage alone, the tutorial's settings, float32, 4 samples
-//! per pixel, and one random combination of stages, precision, methods, offset,
-//! viewer, acceleration and samples. Every pixel must be sound: its colour a
-//! finite number in [0, 1], its normal and Blinn-Phong factors finite, and either
-//! a hit (depth finite and ≥ 0, shadow 0 or 1) or a miss (depth +∞, shadow −1).
-//! With acceleration on, every record must equal the plain loop's (`--accel off`).
+//! per pixel (with each engine), and one random combination of stages, precision,
+//! methods, offset, viewer, acceleration, samples, engine and AVX build. Every
+//! pixel must be sound: its colour a finite number in [0, 1], its normal and
+//! Blinn-Phong factors finite, and either a hit (depth finite and ≥ 0, shadow 0
+//! or 1) or a miss (depth +∞, shadow −1). With acceleration on or the fast
+//! engine, every record must equal the book engine's plain loop (`--accel off
+//! --engine book`).
 //! `the_faults_fuzzing_found_stay_fixed` keeps the five faults these properties
 //! found as cases of their own.
 //!
@@ -123,7 +125,7 @@ impl Tally {
 
 /// The settings every accepted scene is rendered under, named for the report,
 /// followed by `random`.
-fn settings_to_try(random: Settings) -> [(&'static str, Settings); 6] {
+fn settings_to_try(random: Settings) -> [(&'static str, Settings); 7] {
     let defaults = Settings::from(Stages::ALL);
     [
         ("defaults", defaults),
@@ -137,6 +139,14 @@ fn settings_to_try(random: Settings) -> [(&'static str, Settings); 6] {
             },
         ),
         ("spp 4", Settings { spp: 4, ..defaults }),
+        (
+            "fast engine, spp 4",
+            Settings {
+                spp: 4,
+                engine: Engine::Fast,
+                ..defaults
+            },
+        ),
         ("random", random),
     ]
 }

@@ -506,6 +506,10 @@ fn help_states_every_limit_with_the_numbers_the_code_uses() {
         format!("at most {MAX_MAGNITUDE:e} in magnitude"),
         format!("a radius at least {MIN_RADIUS:e} and\n                 {MIN_RADIUS_RATIO:e} of"),
         format!("at most {} MiB", MAX_FILE_BYTES / (1024 * 1024)),
+        format!(
+            "fits in {gigabytes}: about {}\n                 bytes per sphere",
+            raystep::tools::cli::SCALE_BYTES_PER_SPHERE
+        ),
     ] {
         assert!(
             raystep::tools::cli::LIMITS.contains(&stated),
@@ -609,6 +613,45 @@ fn output_that_cannot_be_written_is_an_error_and_a_closed_pipe_is_not() {
     assert_eq!(out.status.code(), Some(0), "a closed pipe");
     assert!(
         out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn threads_that_cannot_start_are_a_message_not_a_panic() {
+    // 1,000 threads' stacks (2 MB each) do not fit in 400 MB of address space.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("ok.toml"), OK_SCENE).unwrap();
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 400000 && exec '{}' render ok.toml --width 20 --height 10 --out out",
+            env!("CARGO_BIN_EXE_raystep")
+        ))
+        .env("RAYON_NUM_THREADS", "1000")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{said}");
+    assert!(
+        said.contains("cannot start the threads to render with (RAYON_NUM_THREADS=1000)"),
+        "{said}"
+    );
+    assert!(!said.contains("panicked"), "{said}");
+    assert_eq!(names(dir.path()), vec!["ok.toml".to_string()]);
+    // With the memory to spare, the same 200 threads render.
+    let out = Command::new(env!("CARGO_BIN_EXE_raystep"))
+        .args([
+            "render", "ok.toml", "--width", "20", "--height", "10", "--out", "out",
+        ])
+        .env("RAYON_NUM_THREADS", "200")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );

@@ -78,8 +78,15 @@ fn scenes() -> Vec<(String, Scene)> {
 
 #[test]
 fn tile_masks_and_the_bvh_change_no_pixel_of_any_scene() {
+    // The book engine asks the BVH; the fast one the tile masks and the BVH's
+    // packet walk.
+    let both =
+        |base: Settings| [Engine::Book, Engine::Fast].map(|engine| Settings { engine, ..base });
     for (name, scene) in scenes() {
-        for base in [Settings::from(Stages::ALL), Settings::tutorial(Stages::ALL)] {
+        for base in both(Settings::from(Stages::ALL))
+            .into_iter()
+            .chain(both(Settings::tutorial(Stages::ALL)))
+        {
             let frames: Vec<Frame> = [Accel::Off, Accel::Auto, Accel::Bvh]
                 .into_iter()
                 .map(|accel| render(&scene, &Settings { accel, ..base }, &|_| {}))
@@ -87,8 +94,9 @@ fn tile_masks_and_the_bvh_change_no_pixel_of_any_scene() {
             for (frame, accel) in frames[1..].iter().zip(["auto", "bvh"]) {
                 assert!(
                     frame.pixels == frames[0].pixels && frame.rays == frames[0].rays,
-                    "{name}: --accel {accel} differs from the plain loop ({:?})",
-                    base.method
+                    "{name}: --accel {accel} differs from the plain loop ({:?}, {} engine)",
+                    base.method,
+                    base.engine
                 );
             }
         }
@@ -120,7 +128,7 @@ fn bits(frame: &Frame) -> Vec<[u32; 12]> {
         .collect()
 }
 
-/// The settings the packet tracer must agree with the scalar one under: every
+/// The settings the fast engine must agree with the book engine under: every
 /// stage alone and in turn, the tutorial's rules, both precisions, both methods,
 /// both offsets (and none at all), both viewers, samples, early stop off, the
 /// plain loop and the BVH.

@@ -6,11 +6,13 @@
 //! test would have missed anyway: the masks never change a pixel. The fast engine
 //! reads them; the book's tracer does not.
 
-use crate::accel::EVERY;
 use crate::camera::Camera;
 use crate::real::{Real, Vector};
 use crate::scene::{Object, Shape};
 use crate::Vec3;
+
+/// Every object: the search mask that skips none.
+pub const EVERY: u64 = u64::MAX;
 
 /// Tile width and height, in pixels.
 pub const TILE: (u32, u32) = (16, 8);

@@ -8,7 +8,8 @@
 //! The book's files never import this one.
 //!
 //! What it does not take in packets (more than [`MAX_OBJECTS`](crate::fast::packet::MAX_OBJECTS) objects without
-//! a BVH), it traces with the book's own row loop, and says so in the frame
+//! a BVH, or a stage the packet loop does not know), it traces with the book's own
+//! row loop, and says so in the frame
 //! ([`Frame::packets`] is then `off`).
 
 pub mod lanes;
@@ -34,7 +35,8 @@ impl<T: Laned> Fast<T> {
     ///
     /// The packet tracer is compiled twice: for any x86-64 processor (SSE2: two
     /// float64 lanes to a register), and for one with AVX (four). Which one runs
-    /// is decided here, from what the processor says it has. Both compute every
+    /// was decided in [`Fast::new`] (`self.avx`: `--avx`, and what the processor
+    /// says it has). Both compute every
     /// lane with the same IEEE operations in the same order, so they give the same
     /// bits; only the number of instructions differs.
     pub fn packet_row(&self, row: u32, line: &mut [PixelRecord]) -> Rays {

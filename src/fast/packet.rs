@@ -40,19 +40,20 @@
 //! traces any of them, and `trace_packet` starts the light's distance and the
 //! direction to the viewer as soon as the hit point is known.
 //!
-//! `--packets on` (the default) traces scenes of up to [`MAX_OBJECTS`] objects by
-//! the plain loop (with the tile masks), and larger ones through the BVH, which a
-//! packet walks together ([`Bvh::search_packet`](crate::bvh::Bvh::search_packet)).
-//! A larger scene without a BVH (`--accel off`, or `--intersect naive`) is traced
-//! one ray at a time.
+//! The fast engine (`--engine fast`) traces scenes of up to [`MAX_OBJECTS`]
+//! objects by the plain loop (with the tile masks), and larger ones through the
+//! BVH, which a packet walks together (`Bvh::search_packet`, in
+//! `src/fast/walk.rs`). A larger scene without a BVH (`--accel off`, or
+//! `--intersect naive`), or a render with a stage `knows` does not list, is left
+//! to the book's row loop, one ray at a time.
 
 use std::borrow::Cow;
 
-use crate::accel::{Accel, EVERY};
+use crate::accel::Accel;
 use crate::aov::{PixelRecord, Rays};
 use crate::camera::lerp_on_grid;
 use crate::fast::lanes::{components, convert, each, powi, F64s, Laned, Lanes, ALL, V3, WIDTH};
-use crate::fast::masks::{TileMasks, TILE};
+use crate::fast::masks::{TileMasks, EVERY, TILE};
 use crate::fast::walk::PacketSearch;
 use crate::real::{Num, Vector};
 use crate::render::{direction_colour, Settings, Tracer, HALF_STEP};
@@ -594,7 +595,7 @@ impl<T: Laned> Fast<T> {
             col as usize % WIDTH == 0,
             "a packet starts at a multiple of {WIDTH}"
         );
-        debug_assert!(self.packets, "a tracer made without packets");
+        debug_assert!(self.packets, "a fast engine made without packets");
         let lanes = ALL >> (WIDTH - n);
         let mut total = Rays::default();
         if !self.book.stages.intersection {

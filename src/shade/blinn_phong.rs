@@ -14,7 +14,7 @@ pub enum Viewer {
     RayOrigin,
 }
 
-// ANCHOR: illuminate
+// ANCHOR: terms
 /// The three terms of Blinn-Phong at one point, and the factors they come from
 /// (what `raystep explain` prints and the `diffuse` and `specular` buffers hold).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -83,7 +83,7 @@ pub fn factors<V: Vec3Num>(normal: V, to_light: V, to_viewer: V) -> (V::Num, V::
     let n_dot_h = normal.dot(half).max(V::Num::of(0.0));
     (l_dot_n, n_dot_h)
 }
-// ANCHOR_END: illuminate
+// ANCHOR_END: terms
 
 /// `x` to the power `e`, `x ≥ 0`. A whole exponent up to 256 (the tutorial's
 /// shininess 100 gives 25) is computed by repeated squaring, several times faster

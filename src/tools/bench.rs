@@ -65,11 +65,11 @@ pub struct Report {
     pub other_yardstick_ratio: Option<f64>,
     /// Peak resident memory of the process so far, in bytes (Linux only).
     pub peak_memory_bytes: Option<u64>,
-    /// The build of the fast engine's packet tracer that ran: `"avx"` (four
-    /// float64 lanes to a register), `"baseline"` (two, as on any x86-64
-    /// processor: SSE2), or `"off"` when one ray at a time was traced (the book
-    /// engine, or the fast engine's fallback to it for a scene it does not take in
-    /// packets).
+    /// The build of the fast engine's packet loop in this run (whichever of the two
+    /// timed engines it is): `"avx"` (four float64 lanes to a register),
+    /// `"baseline"` (two, as on any x86-64 processor: SSE2), or `"off"` when the
+    /// fast engine left the scene to the book's row loop (more than 64 objects
+    /// without a BVH, or a stage it does not know).
     pub packets: &'static str,
 }
 

@@ -36,6 +36,21 @@ fn say_line(text: std::fmt::Arguments) -> Result<(), Error> {
     write_stdout(format!("{text}\n").as_bytes())
 }
 
+/// Start the threads renders run on (rayon's global pool: as many as the machine
+/// has cores, or `RAYON_NUM_THREADS`).
+fn start_threads() -> Result<(), Error> {
+    rayon::ThreadPoolBuilder::new().build_global().map_err(|e| {
+        let asked = std::env::var("RAYON_NUM_THREADS").map_or_else(
+            |_| "one per core".to_string(),
+            |n| format!("RAYON_NUM_THREADS={n}"),
+        );
+        Error::Usage(format!(
+            "cannot start the threads to render with ({asked}): {e}; set RAYON_NUM_THREADS \
+             to fewer, or allow the process more memory"
+        ))
+    })
+}
+
 /// Write `bytes` to standard output, by the rules of [`say_line`].
 fn write_stdout(bytes: &[u8]) -> Result<(), Error> {
     use std::io::Write;
@@ -73,6 +88,8 @@ Limits (a value beyond them is refused with a message, exit code 2):
                  1e-6 of the scene's size
   scene files    at most 16 MiB
   generate       at most 100,000 spheres
+  chart --scale  a --max-count whose largest scene fits in 2.1 GB: about 750
+                 bytes per sphere and 64 per pixel
 Exit codes: 0 done, 2 a mistake in the input, 130 interrupted (Ctrl-C: the files
 of the render before stay as they were).";
 
@@ -260,8 +277,8 @@ pub struct RuleArgs {
     #[arg(long, value_enum, value_name = "on|off")]
     pub early_stop: Option<Switch>,
     /// How the nearest hit is searched for; never changes a pixel: off (the plain
-    /// loop over every object), auto (tile masks for primary rays, and a BVH from
-    /// 24 spheres on), bvh (always a BVH) [default: auto].
+    /// loop over every object), auto (a BVH from 24 spheres on; with --engine fast
+    /// also tile masks for primary rays), bvh (always a BVH) [default: auto].
     #[arg(long, value_enum)]
     pub accel: Option<Accel>,
     /// Which tracer renders; never changes a pixel: book (the code the chapters
@@ -357,6 +374,16 @@ pub struct FiguresArgs {
 
 /// Carry out a parsed command line.
 pub fn run(cli: Cli) -> Result<(), Error> {
+    // The commands that render start their threads first, so that a machine that
+    // cannot give them (RAYON_NUM_THREADS=200 under a memory limit) gets a message
+    // instead of a panic inside rayon. bench builds its own pools, with the same
+    // care; check, diff and generate need none.
+    if !matches!(
+        cli.command,
+        Some(Command::Check(_) | Command::Diff(_) | Command::Generate(_) | Command::Bench(_))
+    ) {
+        start_threads()?;
+    }
     match cli.command {
         None => stages(StagesArgs::default_out()),
         Some(Command::Stages(args)) => stages(args),
@@ -642,6 +669,20 @@ fn bench(mut args: BenchArgs) -> Result<(), Error> {
 }
 
 fn chart(mut args: ChartArgs) -> Result<(), Error> {
+    if args.scale {
+        // The largest count charted (a power of ten or three times one), refused
+        // before anything is made if its scene would not fit in memory.
+        let largest = (0..8)
+            .flat_map(|e| [10u64.pow(e), 3 * 10u64.pow(e)])
+            .filter(|&n| n <= args.max_count)
+            .max()
+            .unwrap_or(1);
+        let size = (
+            args.scene.width.unwrap_or(1920),
+            args.scene.height.unwrap_or(1080),
+        );
+        check_scale_memory(largest as usize, size)?;
+    }
     let mut pending = Pending::new();
     pending.folder(&args.out)?;
     let runs = args.runs as usize;
@@ -661,6 +702,7 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
             .flat_map(|e| [10usize.pow(e), 3 * 10usize.pow(e)])
             .filter(|&n| n as u64 <= args.max_count)
             .collect();
+
         let plain_up_to = 300;
         let renders: u64 = counts
             .iter()
@@ -741,6 +783,33 @@ fn counted_bar(len: u64, label: &str, unit: &str) -> ProgressBar {
             .progress_chars("=> "),
     );
     bar
+}
+
+/// Bytes of memory `chart --scale` takes per sphere of its largest scene, at its
+/// peak: the generated scene, the objects in play, the BVH and the records of the
+/// frame beside them. Measured: `/usr/bin/time -f "%M KB" raystep chart --scale
+/// --max-count 1000000 --runs 1 --width 64 --height 36` peaked at 754 MB, against
+/// 81 MB for 100,000 spheres (about 750 bytes per sphere).
+pub const SCALE_BYTES_PER_SPHERE: u64 = 750;
+
+/// Refuse a `chart --scale` whose largest scene, of `spheres`, would need more
+/// memory than raystep's largest render (the image limit's 2.1 GB), with the figure.
+fn check_scale_memory(spheres: usize, (width, height): (u32, u32)) -> Result<(), Error> {
+    use crate::io::scene_file::{MAX_PIXELS, PEAK_BYTES_PER_PIXEL};
+    let budget = MAX_PIXELS * PEAK_BYTES_PER_PIXEL;
+    let pixels = u64::from(width) * u64::from(height);
+    let need = spheres as u64 * SCALE_BYTES_PER_SPHERE + pixels * PEAK_BYTES_PER_PIXEL;
+    if need > budget {
+        return Err(Error::Usage(format!(
+            "--max-count: a chart up to {spheres} spheres at {width} × {height} would need \
+             about {:.1} GB of memory (about {SCALE_BYTES_PER_SPHERE} bytes per sphere and \
+             {PEAK_BYTES_PER_PIXEL} per pixel); raystep takes at most {:.1} GB, the memory \
+             of its largest render: give a smaller --max-count",
+            need as f64 / 1e9,
+            budget as f64 / 1e9
+        )));
+    }
+    Ok(())
 }
 
 fn diff(args: &DiffArgs) -> Result<(), Error> {

@@ -13,7 +13,8 @@ pub fn seed(width: u32, height: u32) -> Scene {
     scene
 }
 
-/// Render with the tutorial's settings, without progress reporting.
+/// Render with raystep's default settings (the book engine), without progress
+/// reporting.
 pub fn render(scene: &Scene, stages: Stages) -> Frame {
     raystep::render::render(scene, &stages.into(), &|_| {})
 }
