@@ -656,3 +656,266 @@ fn threads_that_cannot_start_are_a_message_not_a_panic() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+#[test]
+fn one_signal_ends_any_command_within_a_second_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("ok.toml"), OK_SCENE).unwrap();
+    let fifo = dir.path().join("fifo.toml");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success(), "mkfifo");
+    let before = names(dir.path());
+    // Reading a FIFO that nobody writes, a benchmark of many runs, a chart: none
+    // of them looks at the flag the first signal raises.
+    for (args, signal) in [
+        (&["check", "fifo.toml"][..], "-INT"),
+        (&["render", "fifo.toml", "--out", "out"], "-TERM"),
+        (&["diff", "fifo.toml", "fifo.toml"], "-INT"),
+        (
+            &[
+                "bench", "--runs", "1000", "--width", "320", "--height", "180",
+            ],
+            "-TERM",
+        ),
+        (
+            &[
+                "chart", "--runs", "1000", "--width", "96", "--height", "54", "--out", "out/c",
+            ],
+            "-INT",
+        ),
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_raystep"))
+            .args(args)
+            .current_dir(dir.path())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(400));
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "{args:?} ended by itself"
+        );
+        send(signal, child.id());
+        let sent = Instant::now();
+        let code = loop {
+            if let Some(status) = child.try_wait().unwrap() {
+                break status.code();
+            }
+            assert!(
+                sent.elapsed() < Duration::from_secs(3),
+                "{args:?} still runs 3 s after {signal}"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        };
+        assert_eq!(code, Some(130), "{args:?} after {signal}");
+        assert!(
+            sent.elapsed() < Duration::from_millis(1500),
+            "{args:?}: {:?}",
+            sent.elapsed()
+        );
+        assert_eq!(names(dir.path()), before, "{args:?} left files");
+    }
+}
+
+#[test]
+fn links_planted_at_temporary_names_are_never_written_through() {
+    use std::os::unix::fs::symlink;
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("ok.toml"), OK_SCENE).unwrap();
+    let victim = dir.path().join("victim.txt");
+    std::fs::write(&victim, "the user's file").unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    // Links at every name the old, predictable scheme would have used, for the
+    // next few process ids, and at a dead process's name (which raystep removes
+    // as abandoned: the link, not its target).
+    let me = std::process::id();
+    for pid in (me..me + 200).chain([4_000_000]) {
+        for name in ["beauty.png", "buffers.exr", "depth.png", "probe"] {
+            let _ = symlink(&victim, out.join(format!(".{name}.{pid}.raystep.tmp")));
+        }
+    }
+    let run = raystep(
+        dir.path(),
+        &[
+            "render", "ok.toml", "--width", "20", "--height", "10", "--out", "out",
+        ],
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "the user's file");
+    assert!(out.join("beauty.png").is_file());
+    // No temporary of raystep's own (`.NAME.PID.NONCE.raystep.tmp`, a nonce of 16
+    // hexadecimal digits) is left.
+    let own: Vec<String> = names(&out)
+        .into_iter()
+        .filter(|n| {
+            let stem = n.strip_suffix(".raystep.tmp").unwrap_or("");
+            stem.rsplit_once('.').is_some_and(|(_, nonce)| {
+                nonce.len() == 16 && u64::from_str_radix(nonce, 16).is_ok()
+            })
+        })
+        .collect();
+    assert!(own.is_empty(), "{own:?}");
+}
+
+/// Every file under `dir` (links as links) with its bytes, to see that nothing
+/// changed.
+fn snapshot(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut all = BTreeMap::new();
+    for name in walk(dir) {
+        let path = dir.join(&name);
+        let name = name.display().to_string();
+        let meta = std::fs::symlink_metadata(&path).unwrap();
+        let bytes = if meta.file_type().is_symlink() {
+            format!("-> {}", std::fs::read_link(&path).unwrap().display()).into_bytes()
+        } else {
+            std::fs::read(&path).unwrap_or_default()
+        };
+        all.insert(name, bytes);
+    }
+    all
+}
+
+#[test]
+fn symbolic_links_are_never_written_or_deleted_through() {
+    use std::os::unix::fs::symlink;
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path();
+    std::fs::write(root.join("ok.toml"), OK_SCENE).unwrap();
+    let elsewhere = root.join("elsewhere");
+    std::fs::create_dir(&elsewhere).unwrap();
+    std::fs::write(elsewhere.join("beauty.png"), "the user's picture").unwrap();
+    std::fs::write(elsewhere.join("depth.png"), "the user's depth").unwrap();
+    std::fs::write(root.join("victim.txt"), "the user's file").unwrap();
+    // A stage folder that is a link to a folder outside: refused, before rendering.
+    let out = root.join("out");
+    std::fs::create_dir(&out).unwrap();
+    symlink("../elsewhere", out.join("03-shadow")).unwrap();
+    let before = snapshot(root);
+    let run = raystep(
+        root,
+        &[
+            "stages", "ok.toml", "--width", "20", "--height", "10", "--out", "out",
+        ],
+    );
+    let said = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{said}");
+    assert!(said.contains("03-shadow: it is a symbolic link"), "{said}");
+    assert_eq!(snapshot(root), before, "a refused run changed something");
+    // Links at raystep's own file names: the link itself is replaced (a written
+    // buffer) or removed (a stale one), never the file it points to.
+    let render = root.join("render");
+    std::fs::create_dir(&render).unwrap();
+    symlink("../victim.txt", render.join("beauty.png")).unwrap();
+    symlink("../elsewhere/depth.png", render.join("depth.png")).unwrap();
+    let run = raystep(
+        root,
+        &[
+            "render", "ok.toml", "--stage", "rays", "--width", "20", "--height", "10", "--out",
+            "render",
+        ],
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(root.join("victim.txt")).unwrap(),
+        "the user's file"
+    );
+    assert_eq!(
+        std::fs::read_to_string(elsewhere.join("depth.png")).unwrap(),
+        "the user's depth"
+    );
+    let beauty = std::fs::symlink_metadata(render.join("beauty.png")).unwrap();
+    assert!(
+        beauty.is_file(),
+        "beauty.png is raystep's file now, not the link"
+    );
+    assert!(!render.join("depth.png").exists(), "the stale link is gone");
+}
+
+#[test]
+fn a_commit_puts_every_file_in_place_or_none() {
+    // A folder at one of the final names: refused before a single rename.
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path();
+    std::fs::write(root.join("ok.toml"), OK_SCENE).unwrap();
+    let run = raystep(
+        root,
+        &[
+            "render", "ok.toml", "--width", "20", "--height", "10", "--out", "out",
+        ],
+    );
+    assert!(run.status.success());
+    std::fs::remove_file(root.join("out/depth.png")).unwrap();
+    std::fs::create_dir(root.join("out/depth.png")).unwrap();
+    std::fs::write(root.join("out/depth.png/mine.txt"), "the user's").unwrap();
+    let before = snapshot(root);
+    let run = raystep(
+        root,
+        &[
+            "render",
+            "ok.toml",
+            "--width",
+            "20",
+            "--height",
+            "10",
+            "--max-depth",
+            "1",
+            "--out",
+            "out",
+        ],
+    );
+    let said = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{said}");
+    assert!(
+        said.contains("depth.png: a folder stands at this name"),
+        "{said}"
+    );
+    assert_eq!(
+        snapshot(root),
+        before,
+        "the folder holds exactly the old files"
+    );
+
+    // A rename that fails half way (here: a temporary removed from under the
+    // commit) is undone: the files renamed before it are the old ones again.
+    use raystep::io::output::Pending;
+    let out = root.join("mixed");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("a.txt"), "old a").unwrap();
+    std::fs::write(out.join("stale.txt"), "old stale").unwrap();
+    let mut pending = Pending::new();
+    pending.folder(&out).unwrap();
+    pending.file(&out.join("a.txt"), b"new a").unwrap();
+    pending.file(&out.join("b.txt"), b"new b").unwrap();
+    pending.remove_on_commit(&out.join("stale.txt"));
+    for entry in std::fs::read_dir(&out).unwrap() {
+        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+        if name.starts_with(".b.txt.") {
+            std::fs::remove_file(out.join(name)).unwrap();
+        }
+    }
+    let error = pending.commit().unwrap_err().to_string();
+    assert!(
+        error.contains("b.txt") && error.contains("nothing was changed"),
+        "{error}"
+    );
+    assert_eq!(
+        names(&out),
+        vec!["a.txt".to_string(), "stale.txt".to_string()],
+        "no temporary and no new file left"
+    );
+    assert_eq!(std::fs::read_to_string(out.join("a.txt")).unwrap(), "old a");
+    assert_eq!(
+        std::fs::read_to_string(out.join("stale.txt")).unwrap(),
+        "old stale"
+    );
+}

@@ -38,12 +38,36 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     pending.commit()
 }
 
+/// Check a folder that raystep names itself inside the output folder (a stage's):
+/// refused if a symbolic link stands at its name (raystep would write, and remove
+/// stale buffers, in the link's target, outside the output folder) or anything
+/// else that is not a folder.
+pub fn check_own_folder(dir: &Path) -> Result<(), Error> {
+    let refuse = |message: &str| {
+        Err(Error::Output {
+            path: dir.to_path_buf(),
+            message: format!("{message}; remove it, or give another --out"),
+        })
+    };
+    match fs::symlink_metadata(dir) {
+        Ok(m) if m.file_type().is_symlink() => refuse(
+            "it is a symbolic link, and raystep writes its own folders only in the output \
+             folder, never through a link",
+        ),
+        Ok(m) if !m.is_dir() => {
+            refuse("it is not a folder, and raystep writes a stage's files here")
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Output files written under temporary names, waiting to be renamed into place
 /// together by [`Pending::commit`].
 ///
 /// Until the commit, no file a reader (or an earlier render) owns is touched: each
 /// file is first written in full beside its final name, as
-/// `.NAME.PID.raystep.tmp`. The commit renames them all (and removes the buffer
+/// `.NAME.PID.NONCE.raystep.tmp`, a name no one can guess and made only where
+/// nothing has it. The commit renames them all (and removes the buffer
 /// files of an earlier render that this one does not have), which takes a few
 /// milliseconds even for `raystep stages`. Dropped without a commit (after an
 /// error, or Ctrl-C, which [`Pending::commit`] checks for), it removes its
@@ -86,14 +110,17 @@ impl Pending {
             .collect();
         for folder in missing.into_iter().rev() {
             match fs::create_dir(folder) {
-                Ok(()) => self.created.push(folder.to_path_buf()),
+                Ok(()) => {
+                    crate::interrupt::made(folder, true);
+                    self.created.push(folder.to_path_buf());
+                }
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && folder.is_dir() => {}
                 Err(e) => return Err(fail(format!("cannot create the output folder: {e}"))),
             }
         }
         let probe = temporary_name(&dir.join("probe"));
-        fs::write(&probe, b"")
-            .and_then(|()| fs::remove_file(&probe))
+        create_new(&probe)
+            .and_then(|_| fs::remove_file(&probe))
             .map_err(|e| fail(format!("cannot write files in the output folder: {e}")))?;
         remove_abandoned_temporaries(dir);
         Ok(())
@@ -102,7 +129,7 @@ impl Pending {
     /// Write `bytes` to a temporary name beside `path`.
     pub fn file(&mut self, path: &Path, bytes: &[u8]) -> Result<(), Error> {
         let temporary = self.register(path);
-        fs::write(&temporary, bytes).map_err(|e| Error::Output {
+        write_new(&temporary, bytes).map_err(|e| Error::Output {
             path: path.to_path_buf(),
             message: e.to_string(),
         })
@@ -136,7 +163,7 @@ impl Pending {
                     .zip(&paths)
                     .zip(&temporaries)
                     .map(|((&b, path), temporary)| {
-                        fs::write(temporary, png_bytes(frame, b))
+                        write_new(temporary, &png_bytes(frame, b))
                             .map_err(|e| fail(path, e.to_string()))
                     })
                     .collect::<Result<Vec<()>, Error>>()
@@ -159,36 +186,106 @@ impl Pending {
         self.stale.push(path.to_path_buf());
     }
 
-    /// Rename every file into place, then remove the stale ones; refused with
-    /// [`Error::Interrupted`] (and everything removed) after Ctrl-C.
+    /// Put every file into place and remove the stale ones, all or nothing;
+    /// refused with [`Error::Interrupted`] (and everything removed) after Ctrl-C.
+    ///
+    /// Anything but a file (or a link) at a final name, a folder say, is refused
+    /// before a single rename. Then each old file (a stale one, or one a new file
+    /// replaces) is first moved aside under a temporary name, and each new file
+    /// renamed into place; should one of those steps fail, everything done is
+    /// undone in reverse, so the folder holds exactly the old files. Only when all
+    /// succeeded are the old files, now aside, removed.
     pub fn commit(mut self) -> Result<(), Error> {
+        // Held while the files are renamed: a watchdog after Ctrl-C waits for it.
+        let mut noted = crate::interrupt::files();
         crate::error::check_interrupt()?;
-        let files = std::mem::take(&mut self.files);
-        for (i, (temporary, path)) in files.iter().enumerate() {
-            if let Err(e) = fs::rename(temporary, path) {
-                // Renames do not fail on a working disk; those done stay done.
-                self.files = files[i..].to_vec();
+        let present = |path: &Path| fs::symlink_metadata(path).ok();
+        for (_, path) in &self.files {
+            if present(path).is_some_and(|m| m.is_dir()) {
                 return Err(Error::Output {
                     path: path.clone(),
-                    message: e.to_string(),
+                    message: "a folder stands at this name, where raystep puts a file of its \
+                              own; nothing was changed: move the folder, or give another --out"
+                        .into(),
                 });
             }
         }
-        self.created.clear();
-        for stale in std::mem::take(&mut self.stale) {
-            if stale.is_file() {
-                fs::remove_file(&stale).map_err(|e| Error::Output {
-                    path: stale.clone(),
-                    message: format!("cannot remove this file of an earlier render: {e}"),
-                })?;
+        let stale: Vec<PathBuf> = std::mem::take(&mut self.stale)
+            .into_iter()
+            .filter(|p| present(p).is_some_and(|m| !m.is_dir()))
+            .collect();
+        // Each step, to undo in reverse: an old file moved aside (its name, and
+        // where it went), or a new file put in place.
+        enum Step {
+            Aside(PathBuf, PathBuf),
+            Placed(PathBuf, PathBuf),
+        }
+        let mut steps = Vec::new();
+        let mut outcome = Ok(());
+        let aside = |path: &Path, steps: &mut Vec<Step>| -> std::io::Result<()> {
+            let backup = temporary_name(path);
+            fs::rename(path, &backup)?;
+            steps.push(Step::Aside(path.to_path_buf(), backup));
+            Ok(())
+        };
+        for path in &stale {
+            if let Err(e) = aside(path, &mut steps) {
+                outcome = Err((
+                    path.clone(),
+                    format!("cannot remove this file of an earlier render: {e}"),
+                ));
+                break;
             }
         }
+        if outcome.is_ok() {
+            for (temporary, path) in &self.files {
+                let placed = match present(path) {
+                    Some(_) => aside(path, &mut steps),
+                    None => Ok(()),
+                }
+                .and_then(|()| fs::rename(temporary, path));
+                match placed {
+                    Ok(()) => steps.push(Step::Placed(temporary.clone(), path.clone())),
+                    Err(e) => {
+                        outcome = Err((path.clone(), e.to_string()));
+                        break;
+                    }
+                }
+            }
+        }
+        if let Err((path, message)) = outcome {
+            // Undo, newest first: a new file goes back to its temporary name (which
+            // the drop removes), an old one back to its own.
+            for step in steps.iter().rev() {
+                let _ = match step {
+                    Step::Placed(temporary, path) => fs::rename(path, temporary),
+                    Step::Aside(path, backup) => fs::rename(backup, path),
+                };
+            }
+            return Err(Error::Output {
+                path,
+                message: format!("{message}; nothing was changed"),
+            });
+        }
+        for step in &steps {
+            match step {
+                Step::Aside(_, backup) => {
+                    let _ = fs::remove_file(backup);
+                }
+                Step::Placed(temporary, _) => noted.retain(|(t, _)| t != temporary),
+            }
+        }
+        self.files.clear();
+        // The folders made for the files now hold them.
+        noted.retain(|(p, _)| !self.created.contains(p));
+        self.created.clear();
         Ok(())
     }
 
     /// Note that `path` is being written, and return its temporary name.
     fn register(&mut self, path: &Path) -> PathBuf {
         let temporary = temporary_name(path);
+        crate::interrupt::made(&temporary, false);
         self.files.push((temporary.clone(), path.to_path_buf()));
         temporary
     }
@@ -200,9 +297,11 @@ impl Drop for Pending {
     fn drop(&mut self) {
         for (temporary, _) in &self.files {
             let _ = fs::remove_file(temporary);
+            crate::interrupt::forget(temporary);
         }
         for folder in self.created.iter().rev() {
             let _ = fs::remove_dir(folder);
+            crate::interrupt::forget(folder);
         }
     }
 }
@@ -210,14 +309,47 @@ impl Drop for Pending {
 /// The suffix of every temporary file raystep writes.
 const TEMPORARY_SUFFIX: &str = ".raystep.tmp";
 
-/// `dir/.NAME.PID.raystep.tmp` for `dir/NAME`: hidden, beside its final name (so
-/// the rename stays on one file system), and naming the process that writes it.
+/// `dir/.NAME.PID.NONCE.raystep.tmp` for `dir/NAME`: hidden, beside its final name
+/// (so the rename stays on one file system), naming the process that writes it,
+/// and with 64 bits no one can guess ([`nonce`]), so that nobody can plant a link
+/// at the name beforehand; it is created with [`create_new`] all the same.
 fn temporary_name(path: &Path) -> PathBuf {
     let name = path
         .file_name()
         .and_then(|n| n.to_str())
         .unwrap_or("output");
-    path.with_file_name(format!(".{name}.{}{TEMPORARY_SUFFIX}", std::process::id()))
+    let (pid, nonce) = (std::process::id(), nonce());
+    path.with_file_name(format!(".{name}.{pid}.{nonce:016x}{TEMPORARY_SUFFIX}"))
+}
+
+/// 64 bits that differ on every call and in every process: the hash of a counter
+/// under the standard library's randomly keyed hasher (keyed from the system's
+/// random source once per process). For temporary names only; no render uses it.
+fn nonce() -> u64 {
+    use std::hash::{BuildHasher, Hasher};
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNT: AtomicU64 = AtomicU64::new(0);
+    static KEYS: std::sync::OnceLock<std::collections::hash_map::RandomState> =
+        std::sync::OnceLock::new();
+    let mut hasher = KEYS.get_or_init(Default::default).build_hasher();
+    hasher.write_u64(COUNT.fetch_add(1, Ordering::Relaxed));
+    hasher.finish()
+}
+
+/// Create `path` for writing, failing if anything (a file, a folder, a symbolic
+/// link, even a dangling one) already has that name: a temporary file is never
+/// opened through someone else's link.
+fn create_new(path: &Path) -> std::io::Result<fs::File> {
+    fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(path)
+}
+
+/// Write `bytes` to a new file `path` ([`create_new`]).
+fn write_new(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    use std::io::Write;
+    create_new(path)?.write_all(bytes)
 }
 
 /// Remove the temporary files in `dir` that a raystep process which no longer
@@ -233,9 +365,19 @@ fn remove_abandoned_temporaries(dir: &Path) {
     for entry in entries.flatten() {
         let name = entry.file_name();
         let Some(name) = name.to_str() else { continue };
+        // `.NAME.PID.NONCE.raystep.tmp` (or `.NAME.PID.raystep.tmp`, before the
+        // names had a nonce).
         let Some(pid) = name
             .strip_prefix('.')
             .and_then(|n| n.strip_suffix(TEMPORARY_SUFFIX))
+            .map(|n| match n.rsplit_once('.') {
+                Some((rest, nonce))
+                    if nonce.len() == 16 && u64::from_str_radix(nonce, 16).is_ok() =>
+                {
+                    rest
+                }
+                _ => n,
+            })
             .and_then(|n| n.rsplit_once('.'))
             .and_then(|(_, pid)| pid.parse::<u32>().ok())
         else {
@@ -498,7 +640,7 @@ fn write_exr(frame: &Frame, temporary: &Path, path: &Path) -> Result<(), Error> 
         path: path.to_path_buf(),
         message,
     };
-    let file = fs::File::create(temporary).map_err(|e| fail(e.to_string()))?;
+    let file = create_new(temporary).map_err(|e| fail(e.to_string()))?;
     let mut writer = BufWriter::new(file);
     exr_to(frame, &mut writer).map_err(|e| fail(format!("cannot write the EXR: {e}")))?;
     writer.flush().map_err(|e| fail(e.to_string()))

@@ -503,6 +503,11 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
     // error or Ctrl-C on the way leaves the folder as it was.
     let mut pending = Pending::new();
     pending.folder(&args.out)?;
+    // The stage folders are raystep's own names: a link or a file at one is
+    // refused now, before anything is rendered.
+    for stage in Stage::ALL {
+        crate::io::output::check_own_folder(&args.out.join(stage.folder()))?;
+    }
     say!(
         "{name}: every stage at {} × {}, {} engine",
         scene.width,
