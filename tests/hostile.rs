@@ -202,6 +202,17 @@ fn fixtures() -> &'static Path {
         exr::prelude::write_rgb_file(at("flat.exr"), 8, 4, |_, _| (0.5f32, 0.5f32, 0.5f32))
             .unwrap();
         exr::prelude::write_rgb_file(at("non-finite.exr"), 8, 4, grey).unwrap();
+        // A real EXR file with a depth channel and no colour.
+        {
+            use exr::prelude::*;
+            let depth = SpecificChannels::build()
+                .with_channel("Z")
+                .with_pixel_fn(|_| (1.0f32,));
+            Image::from_channels((8, 4), depth)
+                .write()
+                .to_file(at("depth-only.exr"))
+                .unwrap();
+        }
         dir
     })
     .path()

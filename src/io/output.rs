@@ -61,6 +61,33 @@ pub fn check_own_folder(dir: &Path) -> Result<(), Error> {
     }
 }
 
+/// The files a render of `stages` puts in `dir`: one PNG per buffer it has, and
+/// [`EXR_FILE`].
+pub fn frame_files(dir: &Path, stages: crate::stages::Stages) -> Vec<PathBuf> {
+    Buffer::ALL
+        .into_iter()
+        .filter(|b| b.written(stages))
+        .map(|b| dir.join(format!("{}.png", b.name())))
+        .chain([dir.join(EXR_FILE)])
+        .collect()
+}
+
+/// Refuse, before anything is rendered, a final name at which a folder stands:
+/// the commit would have to refuse it after the render (see [`Pending::commit`]).
+pub fn check_final_names(paths: &[PathBuf]) -> Result<(), Error> {
+    for path in paths {
+        if fs::symlink_metadata(path).is_ok_and(|m| m.is_dir()) {
+            return Err(Error::Output {
+                path: path.clone(),
+                message: "a folder stands at this name, where raystep puts a file of its own; \
+                          nothing was changed: move the folder, or give another --out"
+                    .into(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Output files written under temporary names, waiting to be renamed into place
 /// together by [`Pending::commit`].
 ///

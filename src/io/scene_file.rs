@@ -182,13 +182,22 @@ const SECTIONS: [(&str, &[&str]); 7] = [
 fn toml_error(e: &toml::de::Error, text: &str) -> String {
     let what = plain_types(e.message().trim_end());
     let with_hint = |what: String| match hint(&what) {
-        Some(h) => format!("{what}; {h}"),
-        None => what,
+        Some(h) => cut_quoted(&format!("{what}; {h}")),
+        None => cut_quoted(&what),
     };
     let Some(span) = e.span() else {
+        if what.contains("recursion limit") {
+            return deepest_nesting(text);
+        }
         return with_hint(what);
     };
     let start = span.start.min(text.len());
+    // A date or time where a number or list belongs: serde calls it a map.
+    let value = &text[start..span.end.clamp(start, text.len())];
+    let what = match what.strip_prefix("invalid type: map") {
+        Some(rest) if looks_like_datetime(value) => format!("invalid type: a date or time{rest}"),
+        _ => what,
+    };
     let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
     let line_end = text[start..].find('\n').map_or(text.len(), |i| start + i);
     let what = brackets(&what, &text[line_start..line_end]).unwrap_or_else(|| with_hint(what));
@@ -213,11 +222,80 @@ fn toml_error(e: &toml::de::Error, text: &str) -> String {
         if to < chars.len() { "…" } else { "" },
     );
     let gutter = " ".repeat(line.to_string().len());
-    let pad = " ".repeat(column - from + dots_before.chars().count());
+    // Under a tab of the line, a tab, so that the mark stands under the place
+    // whatever width a terminal gives a tab.
+    let pad: String = dots_before
+        .chars()
+        .map(|_| ' ')
+        .chain(
+            chars[from..column.max(from)]
+                .iter()
+                .map(|&c| if c == '\t' { '\t' } else { ' ' }),
+        )
+        .collect();
     let marks = "^".repeat(width.min(to.saturating_sub(column)).max(1));
     format!(
         "line {line}, column {}: {what}\n{gutter} |\n{line} | {dots_before}{shown}{dots_after}\n{gutter} | {pad}{marks}",
         column + 1
+    )
+}
+
+/// The message with every `quoted` or "quoted" token longer than 60 characters
+/// cut to its first 40 and last 10 (a 10 MB key or string would otherwise be
+/// quoted whole).
+fn cut_quoted(message: &str) -> String {
+    cut_between(&cut_between(message, '`'), '"')
+}
+
+/// [`cut_quoted`] for the tokens between two `quote`s.
+fn cut_between(message: &str, quote: char) -> String {
+    let mut out = String::with_capacity(message.len().min(4096));
+    for (i, part) in message.split(quote).enumerate() {
+        if i > 0 {
+            out.push(quote);
+        }
+        let chars = part.chars().count();
+        if i % 2 == 1 && chars > 60 {
+            let head: String = part.chars().take(40).collect();
+            let tail: String = part.chars().skip(chars - 10).collect();
+            out.push_str(&format!("{head}…({} characters)…{tail}", chars - 50));
+        } else {
+            out.push_str(part);
+        }
+    }
+    out
+}
+
+/// Does `value` (the text a TOML error points at) read as a TOML date or time,
+/// such as `1979-05-27`, `07:32:00` or `1979-05-27T07:32:00Z`?
+fn looks_like_datetime(value: &str) -> bool {
+    let b = value.trim().as_bytes();
+    let digits = |range: std::ops::Range<usize>| {
+        b.get(range)
+            .is_some_and(|d| d.iter().all(u8::is_ascii_digit))
+    };
+    (digits(0..4) && b.get(4) == Some(&b'-') && digits(5..7))
+        || (digits(0..2) && b.get(2) == Some(&b':'))
+}
+
+/// The message for a file nested deeper than the TOML reader goes (a dotted key
+/// of thousands of parts, say), which the reader gives with no place: the line
+/// with the most levels, found by counting them.
+fn deepest_nesting(text: &str) -> String {
+    let levels = |line: &str| {
+        let key = line.split('=').next().unwrap_or("");
+        key.matches('.').count() + line.matches(['[', '{']).count()
+    };
+    let (number, deepest) = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, levels(l)))
+        .max_by_key(|&(_, n)| n)
+        .unwrap_or((1, 0));
+    format!(
+        "line {number}: nested too deeply for a scene file (about {deepest} levels of dotted keys, \
+         tables or lists on that line); a scene's keys are at most two levels deep, as in \
+         `[[sphere]]` then `radius = 0.5`"
     )
 }
 
@@ -236,6 +314,8 @@ fn plain_types(message: &str) -> String {
         .replace("expected f64", "expected a number")
         .replace("expected a sequence", "expected a list")
         .replace("as i128", "")
+        .replace("`$__toml_private_datetime`", "a date or time")
+        .replace("$__toml_private_datetime", "a date or time")
 }
 
 /// A table header with the wrong number of brackets (serde's own words for it,
@@ -290,6 +370,16 @@ fn unknown_key_hint(unknown: &str, expected: &[&str]) -> Option<String> {
         .filter(|(_, keys)| keys.contains(&unknown))
         .map(|(section, _)| *section)
         .collect();
+    if unknown == "sphere" && !homes.is_empty() {
+        // A sphere of the scene is a section of its own; `sphere = {…}` is how a
+        // [[plane]] entry names the tutorial's fake plane.
+        return Some(
+            "a sphere of the scene is a section of its own: start it with `[[sphere]]`, then \
+             `center = [x, y, z]` and `radius = r` on lines of their own (`sphere = { … }` \
+             belongs under [[plane]], where it makes the tutorial's fake plane)"
+                .into(),
+        );
+    }
     (!homes.is_empty()).then(|| format!("`{unknown}` is a key of {}", homes.join(" and ")))
 }
 

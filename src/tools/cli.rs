@@ -506,7 +506,10 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
     // The stage folders are raystep's own names: a link or a file at one is
     // refused now, before anything is rendered.
     for stage in Stage::ALL {
-        crate::io::output::check_own_folder(&args.out.join(stage.folder()))?;
+        let dir = args.out.join(stage.folder());
+        crate::io::output::check_own_folder(&dir)?;
+        let stages = Stages::up_to(stage);
+        crate::io::output::check_final_names(&crate::io::output::frame_files(&dir, stages))?;
     }
     say!(
         "{name}: every stage at {} × {}, {} engine",
@@ -603,6 +606,10 @@ fn render_one(args: RenderArgs) -> Result<(), Error> {
     let (scene, settings) = prepare(&args.frame)?;
     let mut pending = Pending::new();
     pending.folder(&args.out)?;
+    crate::io::output::check_final_names(&crate::io::output::frame_files(
+        &args.out,
+        settings.stages,
+    ))?;
     let name = scene_name(&args.frame.scene);
     say!(
         "{name}: {} at {} × {}, {} engine",

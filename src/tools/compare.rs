@@ -92,6 +92,26 @@ pub fn read_beauty(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>), Error> 
         .map(|h| h.layer_size.area() as u64)
         .max()
         .ok_or_else(|| fail("has no image layer".into()))?;
+    // A real EXR file may hold no colour at all (a depth pass, say): say so, with
+    // the channels it has, rather than that it is no EXR.
+    let names = |h: &exr::meta::header::Header| -> Vec<String> {
+        h.channels.list.iter().map(|c| c.name.to_string()).collect()
+    };
+    let coloured = |h: &exr::meta::header::Header| {
+        let n = names(h);
+        ["R", "G", "B"].iter().all(|c| n.iter().any(|m| m == c))
+    };
+    if !meta.headers.iter().any(coloured) {
+        let has: Vec<String> = meta.headers.iter().flat_map(names).collect();
+        return Err(fail(format!(
+            "has no R, G and B channels (it has {}); raystep's buffers.exr has them",
+            if has.is_empty() {
+                "none".to_string()
+            } else {
+                has.join(", ")
+            }
+        )));
+    }
     if largest > MAX_PIXELS {
         return Err(fail(format!(
             "holds an image of {largest} pixels; raystep compares at most {MAX_PIXELS}, \
