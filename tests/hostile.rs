@@ -250,7 +250,7 @@ fn every_bad_scene_file_ends_in_its_message_and_writes_nothing() {
             );
         }
     }
-    assert!(paths.len() >= 70, "{} scene files", paths.len());
+    assert!(paths.len() >= 127, "{} scene files", paths.len());
 }
 
 #[test]
@@ -282,7 +282,9 @@ fn every_bad_command_line_ends_in_its_message_and_writes_nothing() {
             );
         }
     }
-    assert!(cases.len() >= 50, "{} command cases", cases.len());
+    assert!(cases.len() >= 77, "{} command cases", cases.len());
+    // With the scene files: the 200 inputs of the corpus, at least.
+    assert!(cases.len() + scene_files().len() >= 200);
 }
 
 /// The output folder of a case where the user cannot write (only when not root:

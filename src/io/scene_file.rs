@@ -313,7 +313,12 @@ fn plain_types(message: &str) -> String {
         )
         .replace("expected f64", "expected a number")
         .replace("expected a sequence", "expected a list")
-        .replace("as i128", "")
+        .replace(
+            " as i128, expected a number",
+            ", beyond TOML's 64-bit integers: write it with an exponent (1e29) or a decimal \
+             point, expected a number",
+        )
+        .replace(" as i128", "")
         .replace("`$__toml_private_datetime`", "a date or time")
         .replace("$__toml_private_datetime", "a date or time")
 }
