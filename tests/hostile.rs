@@ -932,3 +932,49 @@ fn a_commit_puts_every_file_in_place_or_none() {
         "old stale"
     );
 }
+
+#[test]
+fn temporaries_are_removed_even_from_a_folder_moved_during_the_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path();
+    let child = Command::new(env!("CARGO_BIN_EXE_raystep"))
+        .args([
+            "stages", "--width", "960", "--height", "540", "--out", "out",
+        ])
+        .current_dir(root)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The folder is made at the start; move it away while the stages render.
+    let started = Instant::now();
+    while !root.join("out").is_dir() {
+        assert!(
+            started.elapsed() < Duration::from_secs(20),
+            "no output folder"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    std::fs::rename(root.join("out"), root.join("moved")).unwrap();
+    let out = child.wait_with_output().unwrap();
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{said}");
+    assert!(
+        said.contains("was moved or replaced while raystep rendered into it")
+            || said.contains("No such file or directory"),
+        "{said}"
+    );
+    // Nothing was put in place, at the old path or in the moved folder, and no
+    // temporary is left in the moved one.
+    assert!(!root.join("out").exists(), "something at the old path");
+    let moved = root.join("moved");
+    let files: Vec<PathBuf> = walk(&moved)
+        .into_iter()
+        .filter(|n| !moved.join(n).is_dir())
+        .collect();
+    assert!(
+        files.is_empty(),
+        "files left in the moved folder: {files:?}"
+    );
+}

@@ -109,6 +109,19 @@ pub struct Pending {
     stale: Vec<PathBuf>,
     /// Folders created for this write, outermost first.
     created: Vec<PathBuf>,
+    /// Every folder written into: its path, the folder itself held open, and
+    /// which folder it was (device and inode), to notice one moved or replaced
+    /// during the render and to clean up inside it all the same.
+    folders: Vec<(PathBuf, Option<fs::File>, Option<Identity>)>,
+}
+
+/// Which file or folder stands at a path: its device and inode.
+type Identity = (u64, u64);
+
+/// The device and inode of what stands at `path` (not following a link).
+fn identity(path: &Path) -> Option<Identity> {
+    use std::os::unix::fs::MetadataExt;
+    fs::symlink_metadata(path).ok().map(|m| (m.dev(), m.ino()))
 }
 
 impl Pending {
@@ -145,6 +158,8 @@ impl Pending {
                 Err(e) => return Err(fail(format!("cannot create the output folder: {e}"))),
             }
         }
+        let held = fs::File::open(dir).ok();
+        self.folders.push((dir.to_path_buf(), held, identity(dir)));
         let probe = temporary_name(&dir.join("probe"));
         create_new(&probe)
             .and_then(|_| fs::remove_file(&probe))
@@ -226,6 +241,14 @@ impl Pending {
         // Held while the files are renamed: a watchdog after Ctrl-C waits for it.
         let mut noted = crate::interrupt::files();
         crate::error::check_interrupt()?;
+        if let Some((dir, _, _)) = self.folders.iter().find(|(d, _, was)| identity(d) != *was) {
+            return Err(Error::Output {
+                path: dir.clone(),
+                message: "this folder was moved or replaced while raystep rendered into it; \
+                          nothing was put in place, and the files begun in it were removed"
+                    .into(),
+            });
+        }
         let present = |path: &Path| fs::symlink_metadata(path).ok();
         for (_, path) in &self.files {
             if present(path).is_some_and(|m| m.is_dir()) {
@@ -309,6 +332,29 @@ impl Pending {
         Ok(())
     }
 
+    /// Where the temporary file `temporary` is now: at its path, unless its folder
+    /// was moved or replaced since, and then inside the folder held open (through
+    /// `/proc/self/fd` on Linux; elsewhere the path is all there is).
+    fn where_now(&self, temporary: &Path) -> PathBuf {
+        let (Some(dir), Some(name)) = (temporary.parent(), temporary.file_name()) else {
+            return temporary.to_path_buf();
+        };
+        for (folder, held, was) in &self.folders {
+            if folder == dir && identity(folder) != *was {
+                if let Some(held) = held {
+                    use std::os::fd::AsRawFd;
+                    let through = Path::new("/proc/self/fd")
+                        .join(held.as_raw_fd().to_string())
+                        .join(name);
+                    if through.parent().is_some_and(Path::exists) {
+                        return through;
+                    }
+                }
+            }
+        }
+        temporary.to_path_buf()
+    }
+
     /// Note that `path` is being written, and return its temporary name.
     fn register(&mut self, path: &Path) -> PathBuf {
         let temporary = temporary_name(path);
@@ -323,11 +369,18 @@ impl Drop for Pending {
     /// them if they are empty (`remove_dir` refuses a folder that is not).
     fn drop(&mut self) {
         for (temporary, _) in &self.files {
-            let _ = fs::remove_file(temporary);
+            let _ = fs::remove_file(self.where_now(temporary));
             crate::interrupt::forget(temporary);
         }
         for folder in self.created.iter().rev() {
-            let _ = fs::remove_dir(folder);
+            // Only the folder raystep made: not one that took its name since.
+            if self
+                .folders
+                .iter()
+                .all(|(d, _, was)| d != folder || identity(d) == *was)
+            {
+                let _ = fs::remove_dir(folder);
+            }
             crate::interrupt::forget(folder);
         }
     }
