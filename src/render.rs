@@ -456,30 +456,45 @@ fn render_in<T: Real>(
     let tracer = &Tracer::<T>::new(scene, settings);
     let width = tracer.camera.width as usize;
     assert_eq!(frame.pixels.len(), width * tracer.camera.height as usize);
-    let rays = frame
+    let rays = in_rows(frame, width, progress, |row, line| {
+        book_row(tracer, settings.spp, row, line)
+    });
+    frame.describe(scene, tracer, settings, rays);
+    frame.book_paths = rays.primary;
+}
+
+/// The rows of `frame` (`width` pixels each) traced in parallel by `row`, which
+/// fills one row's records and returns the rays they took; `progress(1)` after
+/// each row. After Ctrl-C the rows left are skipped (and the frame is thrown
+/// away). Returns the rays of the whole frame. Both engines render through it.
+pub fn in_rows(
+    frame: &mut Frame,
+    width: usize,
+    progress: &(dyn Fn(u64) + Sync),
+    row: impl Fn(u32, &mut [PixelRecord]) -> Rays + Sync,
+) -> Rays {
+    frame
         .pixels
         .par_chunks_mut(width)
         .enumerate()
-        .map(|(row, line)| {
-            let rays = book_row(tracer, settings.spp, row as u32, line);
+        .map(|(r, line)| {
+            if crate::interrupt::requested() {
+                return Rays::default();
+            }
+            let rays = row(r as u32, line);
             progress(1);
             rays
         })
         .reduce(Rays::default, |mut a, b| {
             a += b;
             a
-        });
-    frame.describe(scene, tracer, settings, rays);
-    frame.book_paths = rays.primary;
+        })
 }
 
 // ANCHOR: row
 /// The records of row `row` into `line`, pixel by pixel, and the rays they took.
 pub fn book_row<T: Real>(tracer: &Tracer<T>, spp: u32, row: u32, line: &mut [PixelRecord]) -> Rays {
     let mut rays = Rays::default();
-    if crate::interrupt::requested() {
-        return rays; // Ctrl-C: the rest is skipped, and the frame thrown away
-    }
     for (col, out) in line.iter_mut().enumerate() {
         let col = col as u32;
         let mut path = Rays::default();

@@ -17,14 +17,12 @@ pub mod masks;
 pub mod packet;
 pub mod walk;
 
-use rayon::prelude::*;
-
 use crate::aov::{Frame, Packets, PixelRecord, Rays};
 use crate::fast::lanes::{Laned, WIDTH};
 pub use crate::fast::packet::Fast;
 use crate::fast::packet::BATCH;
 use crate::real::Precision;
-use crate::render::{book_row, Settings};
+use crate::render::{book_row, in_rows, Settings};
 use crate::scene::Scene;
 use crate::stages::Engine;
 
@@ -95,9 +93,6 @@ impl<T: Laned> Fast<T> {
     /// The records of row `row` into `line` and the rays they took: in packets,
     /// or by the book's row loop for what the packets do not take.
     pub fn row(&self, row: u32, line: &mut [PixelRecord]) -> Rays {
-        if crate::interrupt::requested() {
-            return Rays::default(); // Ctrl-C: the rest is skipped, and the frame thrown away
-        }
         match self.packets {
             true => self.packet_row(row, line),
             false => book_row(&self.book, self.spp, row, line),
@@ -142,19 +137,7 @@ fn render_in<T: Laned>(
 ) {
     let width = scene.width as usize;
     assert_eq!(frame.pixels.len(), width * scene.height as usize);
-    let rays = frame
-        .pixels
-        .par_chunks_mut(width)
-        .enumerate()
-        .map(|(row, line)| {
-            let rays = fast.row(row as u32, line);
-            progress(1);
-            rays
-        })
-        .reduce(Rays::default, |mut a, b| {
-            a += b;
-            a
-        });
+    let rays = in_rows(frame, width, progress, |row, line| fast.row(row, line));
     frame.describe(scene, &fast.book, settings, rays);
     frame.engine = Engine::Fast;
     frame.packets = match (fast.packets, fast.avx) {

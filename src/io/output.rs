@@ -249,17 +249,9 @@ impl Pending {
                     .into(),
             });
         }
+        let finals: Vec<PathBuf> = self.files.iter().map(|(_, path)| path.clone()).collect();
+        check_final_names(&finals)?;
         let present = |path: &Path| fs::symlink_metadata(path).ok();
-        for (_, path) in &self.files {
-            if present(path).is_some_and(|m| m.is_dir()) {
-                return Err(Error::Output {
-                    path: path.clone(),
-                    message: "a folder stands at this name, where raystep puts a file of its \
-                              own; nothing was changed: move the folder, or give another --out"
-                        .into(),
-                });
-            }
-        }
         let stale: Vec<PathBuf> = std::mem::take(&mut self.stale)
             .into_iter()
             .filter(|p| present(p).is_some_and(|m| !m.is_dir()))

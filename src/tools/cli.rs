@@ -681,19 +681,19 @@ fn bench(mut args: BenchArgs) -> Result<(), Error> {
 }
 
 fn chart(mut args: ChartArgs) -> Result<(), Error> {
+    // --scale: the image size and the sphere counts charted (powers of ten and
+    // their triples up to --max-count), refused before anything is made if the
+    // largest scene would not fit in memory.
+    let size = (
+        args.scene.width.unwrap_or(1920),
+        args.scene.height.unwrap_or(1080),
+    );
+    let counts: Vec<usize> = (0..8)
+        .flat_map(|e| [10usize.pow(e), 3 * 10usize.pow(e)])
+        .filter(|&n| n as u64 <= args.max_count)
+        .collect();
     if args.scale {
-        // The largest count charted (a power of ten or three times one), refused
-        // before anything is made if its scene would not fit in memory.
-        let largest = (0..8)
-            .flat_map(|e| [10u64.pow(e), 3 * 10u64.pow(e)])
-            .filter(|&n| n <= args.max_count)
-            .max()
-            .unwrap_or(1);
-        let size = (
-            args.scene.width.unwrap_or(1920),
-            args.scene.height.unwrap_or(1080),
-        );
-        check_scale_memory(largest as usize, size)?;
+        check_scale_memory(counts.last().copied().unwrap_or(1), size)?;
     }
     let mut pending = Pending::new();
     pending.folder(&args.out)?;
@@ -704,17 +704,8 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
         ));
     }
     if args.scale {
-        let size = (
-            args.scene.width.unwrap_or(1920),
-            args.scene.height.unwrap_or(1080),
-        );
         crate::io::scene_file::check_image_size((size.0, "--width"), (size.1, "--height"))
             .map_err(Error::Usage)?;
-        let counts: Vec<usize> = (0..8)
-            .flat_map(|e| [10usize.pow(e), 3 * 10usize.pow(e)])
-            .filter(|&n| n as u64 <= args.max_count)
-            .collect();
-
         let plain_up_to = 300;
         let renders: u64 = counts
             .iter()

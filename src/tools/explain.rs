@@ -250,7 +250,7 @@ struct Story<'a, T: Real> {
 
 impl<T: Real> Story<'_, T> {
     /// The hit of the segment being told.
-    fn hit(&mut self) -> &mut HitInfo {
+    fn current_hit(&mut self) -> &mut HitInfo {
         let segment = self.told.segments.last_mut();
         let hit = segment.and_then(|s| s.hit.as_mut());
         hit.expect("the book's trace reports a hit before what it computes there")
@@ -304,7 +304,7 @@ impl<T: Real> Observer<T> for Story<'_, T> {
         // whether there is one before the light).
         let blocker = nearest_hit(&self.tracer.objects, ray, self.tracer.method);
         let light_distance = light_distance.to_f64();
-        let hit = self.hit();
+        let hit = self.current_hit();
         hit.lit = blocker.is_none_or(|b| b.t.to_f64() >= light_distance);
         hit.shadow = Some(ShadowInfo {
             ray: info(ray),
@@ -314,9 +314,9 @@ impl<T: Real> Observer<T> for Story<'_, T> {
     }
 
     fn shaded(&mut self, t: &Terms<T>, to_light: T::Vec3, to_viewer: T::Vec3) {
-        let object = self.hit().object;
+        let object = self.current_hit().object;
         let shininess = self.tracer.objects[object].material.shininess;
-        self.hit().shading = Some(Shading {
+        self.current_hit().shading = Some(Shading {
             to_light: to_light.to_f64().to_array(),
             to_viewer: to_viewer.to_f64().to_array(),
             l_dot_n: t.l_dot_n.to_f64(),
@@ -331,7 +331,7 @@ impl<T: Real> Observer<T> for Story<'_, T> {
 
     fn added(&mut self, illumination: T::Vec3, sum: T::Vec3) {
         self.sum = sum;
-        let hit = self.hit();
+        let hit = self.current_hit();
         hit.illumination = Some(illumination.to_f64().to_array());
         hit.sum = sum.to_f64().to_array();
     }
@@ -345,7 +345,7 @@ impl<T: Real> Observer<T> for Story<'_, T> {
             }
             End::Miss => format!("reflection {index} hits nothing: the sky adds no light"),
             End::Shadow => {
-                self.hit().lit = false;
+                self.current_hit().lit = false;
                 format!(
                     "the point of segment {index} does not see the light: the path ends there \
                      and adds nothing more (the tutorial's rule)"
