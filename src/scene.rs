@@ -160,7 +160,7 @@ impl<T: Real> Object<T> {
 }
 
 /// The first object along `ray`: test them all, keep the smallest distance.
-#[inline]
+#[inline(always)]
 pub fn nearest_hit<T: Real>(objects: &[Object<T>], ray: &Ray<T>, method: Method) -> Option<Hit<T>> {
     let mut nearest: Option<Hit<T>> = None;
     for (index, object) in objects.iter().enumerate() {
@@ -175,11 +175,14 @@ pub fn nearest_hit<T: Real>(objects: &[Object<T>], ray: &Ray<T>, method: Method)
 
 /// Is any object hit along `ray` closer than `distance`? The shadow test needs
 /// only a yes or a no, so it stops at the first blocker it finds.
-#[inline]
+#[inline(always)]
 pub fn blocked<T: Real>(objects: &[Object<T>], ray: &Ray<T>, distance: T, method: Method) -> bool {
-    objects
-        .iter()
-        .any(|o| o.intersect(ray, method).is_some_and(|t| t < distance))
+    for object in objects {
+        if object.intersect(ray, method).is_some_and(|t| t < distance) {
+            return true;
+        }
+    }
+    false
 }
 // ANCHOR_END: nearest_hit
 

@@ -42,6 +42,12 @@ impl<T: Real> Sphere<T> {
     /// smaller root is the distance.
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray<T>, method: Method) -> Option<T> {
+        // Both crossings can be in front only if the ray moves towards the centre.
+        // When it does not, nothing is left to solve: this changes no answer, it
+        // only skips the square root for spheres behind the ray.
+        if ray.direction.dot(self.center - ray.origin) <= T::of(0.0) {
+            return None;
+        }
         let (near, far) = match method {
             Method::Naive => self.roots_naive(ray)?,
             Method::Stable => self.roots_stable(ray)?,
@@ -94,25 +100,26 @@ impl<T: Real> Sphere<T> {
 impl<T: Real> Sphere<T> {
     /// The same two roots, computed so that no step subtracts nearly equal numbers.
     ///
-    /// With `f = O − C` and the half-coefficient `h = −⟨d, f⟩` (the distance along
-    /// the ray to the point closest to the centre), the roots are `h ± √(Δ/4)`, and
-    /// `Δ/4 = r² − ‖f + h·d‖²`: the radius squared minus the squared distance from
-    /// the centre to that closest point. The textbook `b² − 4c` computes the same
-    /// number as the difference of two large terms, which loses every digit when the
-    /// sphere is small or far compared with `‖f‖`.
+    /// With `m = C − O` (from the origin to the centre) and the half-coefficient
+    /// `h = ⟨d, m⟩` (the distance along the ray to the point closest to the centre),
+    /// the roots are `h ± √(Δ/4)`, and `Δ/4 = r² − ‖h·d − m‖²`: the radius squared
+    /// minus the squared distance from the centre to that closest point. The
+    /// textbook `b² − 4c` computes the same number as the difference of two large
+    /// terms, which loses every digit when the sphere is small or far compared with
+    /// `‖m‖`.
     ///
     /// `q = h + sign(h)·√(Δ/4)` adds two numbers of one sign; the other root is
-    /// `c/q`, because the product of the roots is `c`.
+    /// `c/q`, because the product of the roots is `c = ‖m‖² − r²`.
     #[inline(always)]
     pub fn roots_stable(&self, ray: &Ray<T>) -> Option<(T, T)> {
-        let f = ray.origin - self.center;
-        let h = -ray.direction.dot(f);
-        let closest = f + ray.direction * h;
+        let m = self.center - ray.origin;
+        let h = ray.direction.dot(m);
+        let closest = ray.direction * h - m;
         let r2 = self.radius * self.radius;
         let quarter_delta = r2 - closest.length_squared();
         if quarter_delta > T::of(0.0) {
             let q = h + h.signum() * quarter_delta.sqrt();
-            let c = f.length_squared() - r2;
+            let c = m.length_squared() - r2;
             let (t1, t2) = (c / q, q);
             // |q| = |h| + √(Δ/4) > 0, so c/q never divides by zero; the guard keeps
             // it so if that reasoning is ever broken. (A NaN passes it, and fails
@@ -136,9 +143,9 @@ impl<T: Real> Sphere<T> {
 
     /// `Δ/4 = r² − ‖f + h·d‖²` of [`Sphere::roots_stable`], as it computes it.
     pub fn quarter_discriminant(&self, ray: &Ray<T>) -> T {
-        let f = ray.origin - self.center;
-        let h = -ray.direction.dot(f);
-        self.radius * self.radius - (f + ray.direction * h).length_squared()
+        let m = self.center - ray.origin;
+        let h = ray.direction.dot(m);
+        self.radius * self.radius - (ray.direction * h - m).length_squared()
     }
 }
 
@@ -249,5 +256,60 @@ mod tests {
     fn the_normal_is_unit_and_points_outwards() {
         let n = UNIT.normal_at(Vec3::new(0.0, 0.0, -4.0));
         assert_eq!(n, Vec3::new(0.0, 0.0, 1.0));
+    }
+
+    /// The tutorial's rule applied to the roots alone, without the shortcut.
+    fn by_the_roots<T: Real>(s: &Sphere<T>, r: &Ray<T>, m: Method) -> Option<T> {
+        let (near, far) = match m {
+            Method::Naive => s.roots_naive(r)?,
+            Method::Stable => s.roots_stable(r)?,
+        };
+        (near > T::of(0.0) && far > T::of(0.0)).then_some(near)
+    }
+
+    #[test]
+    fn the_shortcut_for_spheres_behind_changes_no_answer() {
+        // Origins inside, on, beside, in front of and behind the sphere; directions
+        // towards, away from, across and grazing it; both precisions.
+        let mut checked = 0;
+        let mut skipped = 0;
+        for (ox, oy, oz) in [
+            (0.0, 0.0, 0.0),
+            (0.0, 0.0, -5.0),
+            (0.0, 1.0, -5.0),
+            (0.3, -0.2, -4.5),
+            (0.0, 0.0, -10.0),
+            (2.0, 1.0, -5.0),
+            (0.0, 0.0, -4.0),
+            (1e3, -2e2, 7e2),
+        ] {
+            for i in 0..400 {
+                let a = i as f64 * 0.157;
+                let b = (i % 37) as f64 * 0.087 - 1.6;
+                let d = [a.cos() * b.cos(), b.sin(), a.sin() * b.cos()];
+                for m in METHODS {
+                    let r = ray([ox, oy, oz], d);
+                    let expected = by_the_roots(&UNIT, &r, m);
+                    assert_eq!(UNIT.intersect(&r, m), expected, "{m} {r:?}");
+                    let r32 = Ray::<f32> {
+                        origin: glam::Vec3::new(ox as f32, oy as f32, oz as f32),
+                        direction: glam::Vec3::from(d.map(|c| c as f32)).normalize(),
+                    };
+                    let s32 = Sphere::<f32> {
+                        center: glam::Vec3::new(0.0, 0.0, -5.0),
+                        radius: 1.0,
+                    };
+                    assert_eq!(s32.intersect(&r32, m), by_the_roots(&s32, &r32, m));
+                    checked += 1;
+                    let towards = r.direction.dot(UNIT.center - r.origin);
+                    skipped += usize::from(towards <= 0.0 && m == Method::Stable);
+                }
+            }
+        }
+        // The comparison covered rays the shortcut answers and rays it does not.
+        assert!(
+            skipped > 1000 && skipped < checked / 2,
+            "{skipped} of {checked}"
+        );
     }
 }

@@ -558,25 +558,17 @@ impl<T: Laned> Vec3Num for V3<T> {
     }
 }
 
-/// `x` to the whole power `n[i]` in lane `i`, by the repeated squaring of Rust's
-/// `powi` (compiler-builtins' `__powidf2`: multiply the result by `x^(2^k)` for
-/// each set bit `k` of `n`, lowest first), so that each lane rounds as `powi` does.
+/// `x` to the whole power `n[i]` in lane `i`, by the repeated squaring of
+/// [`crate::shade::blinn_phong::whole_power`] (Rust's `powi`: multiply the result
+/// by `x^(2^k)` for each set bit `k` of `n`, lowest first), so that each lane
+/// rounds as the book's engine does.
 #[inline(always)]
 pub fn powi<T: Laned>(x: T::Lanes, n: [u32; WIDTH]) -> T::Lanes {
     let one = T::Lanes::splat(T::of(1.0));
     if n.iter().all(|&k| k == n[0]) {
-        // One exponent for every lane (all four hit the same object): no masks.
-        let (mut result, mut square, mut k) = (one, x, n[0]);
-        loop {
-            if k & 1 == 1 {
-                result = result * square;
-            }
-            k >>= 1;
-            if k == 0 {
-                return result;
-            }
-            square = square * square;
-        }
+        // One exponent for every lane (all four hit the same object): the book's
+        // body, no masks.
+        return crate::shade::blinn_phong::whole_power(x, n[0]);
     }
     let mut result = one;
     let mut square = x;
