@@ -52,13 +52,37 @@ fn includes(text: &str) -> Vec<(String, Option<String>)> {
     found
 }
 
+/// The appendix that states the tutorial's rules, listed after the chapters.
+const APPENDIX: &str = "tutorial-rules.md";
+
 #[test]
 fn every_chapter_file_is_in_the_summary_and_there_are_eleven_chapters() {
     let listed: Vec<String> = chapters().into_iter().map(|(n, _)| n).collect();
     assert_eq!(
         listed.len(),
-        12,
-        "the introduction and eleven chapters: {listed:?}"
+        13,
+        "the introduction, eleven chapters and the appendix: {listed:?}"
+    );
+    assert_eq!(listed[0], "introduction.md", "{listed:?}");
+    for (i, name) in listed[1..12].iter().enumerate() {
+        assert!(
+            name.starts_with(&format!("{:02}-", i + 1)),
+            "chapter {} should be numbered {:02}: {listed:?}",
+            i + 1,
+            i + 1
+        );
+    }
+    assert_eq!(listed[12], APPENDIX, "the appendix comes last: {listed:?}");
+    // A suffix chapter: a plain link after the numbered list, not an item of it.
+    let summary = std::fs::read_to_string(root().join("chapters/SUMMARY.md")).unwrap();
+    let lines: Vec<&str> = summary.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| l.contains(&format!("]({APPENDIX})")))
+        .unwrap();
+    assert!(
+        lines[at].starts_with('[') && at > 0 && lines[at - 1].trim().is_empty(),
+        "SUMMARY.md should list {APPENDIX} as a suffix chapter, after a blank line"
     );
     for entry in std::fs::read_dir(root().join("chapters")).unwrap() {
         let name = entry.unwrap().file_name().to_string_lossy().into_owned();
@@ -76,7 +100,7 @@ fn every_include_names_a_file_and_anchor_with_text() {
             .filter(|(p, _)| p.starts_with("../src/"))
             .count();
         assert!(
-            name == "introduction.md" || from_src > 0,
+            name == "introduction.md" || name == APPENDIX || from_src > 0,
             "{name} shows no code from src/"
         );
         for (path, anchor) in includes(&text) {
@@ -312,8 +336,10 @@ fn the_numbers_the_chapters_quote_are_measured_again() {
             d.saturated.0
         ),
     );
-    // The tutorial's own count for the same change (TUTORIAL.md): 2,660 pixels.
+    // The tutorial's own count for the same change, as the appendix states it:
+    // 2,660 pixels.
     assert_eq!(d.over_one_step, 2660);
+    assert_quotes("tutorial-rules", "2,660 pixels by more than 1/255");
 }
 
 #[test]
