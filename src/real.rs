@@ -66,8 +66,6 @@ pub trait Real: Num + Debug + PartialOrd + Send + Sync + 'static {
     fn abs(self) -> Self;
     /// `self` to the power `e`.
     fn powf(self, e: Self) -> Self;
-    /// `self` to a whole power, by repeated multiplication.
-    fn powi(self, n: i32) -> Self;
     /// The smaller of two.
     fn min(self, other: Self) -> Self;
     /// 1 with the sign of `self` (+1 for +0).
@@ -124,9 +122,6 @@ macro_rules! real {
             }
             fn powf(self, e: $t) -> $t {
                 <$t>::powf(self, e)
-            }
-            fn powi(self, n: i32) -> $t {
-                <$t>::powi(self, n)
             }
             fn min(self, other: $t) -> $t {
                 <$t>::min(self, other)

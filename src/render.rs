@@ -256,8 +256,8 @@ impl<T: Real> Tracer<T> {
 
     // `pixel`, `trace` and the searches they call are inlined into the row loop:
     // called, they hand the ray, the hit and the colour over through memory, and
-    // each reload waits for the store before it (about a tenth of a frame,
-    // `raystep bench --engine book`); inlined, those values stay in registers.
+    // each reload waits for the store before it (about a tenth of a frame in
+    // `perf record raystep bench --engine book`); inlined, they stay in registers.
     // ANCHOR: pixel
     /// The colour of pixel (`row`, `col`) and its first hit. With only the `rays`
     /// stage on, the colour shows the ray's direction: each component mapped from

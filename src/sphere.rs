@@ -141,7 +141,7 @@ impl<T: Real> Sphere<T> {
         b * b - T::of(4.0) * (oc.length_squared() - self.radius * self.radius)
     }
 
-    /// `Δ/4 = r² − ‖f + h·d‖²` of [`Sphere::roots_stable`], as it computes it.
+    /// `Δ/4 = r² − ‖h·d − m‖²` of [`Sphere::roots_stable`], as it computes it.
     pub fn quarter_discriminant(&self, ray: &Ray<T>) -> T {
         let m = self.center - ray.origin;
         let h = ray.direction.dot(m);
@@ -271,6 +271,10 @@ mod tests {
     fn the_shortcut_for_spheres_behind_changes_no_answer() {
         // Origins inside, on, beside, in front of and behind the sphere; directions
         // towards, away from, across and grazing it; both precisions.
+        let s32 = Sphere::<f32> {
+            center: glam::Vec3::new(0.0, 0.0, -5.0),
+            radius: 1.0,
+        };
         let mut checked = 0;
         let mut skipped = 0;
         for (ox, oy, oz) in [
@@ -294,10 +298,6 @@ mod tests {
                     let r32 = Ray::<f32> {
                         origin: glam::Vec3::new(ox as f32, oy as f32, oz as f32),
                         direction: glam::Vec3::from(d.map(|c| c as f32)).normalize(),
-                    };
-                    let s32 = Sphere::<f32> {
-                        center: glam::Vec3::new(0.0, 0.0, -5.0),
-                        radius: 1.0,
                     };
                     assert_eq!(s32.intersect(&r32, m), by_the_roots(&s32, &r32, m));
                     checked += 1;

@@ -196,7 +196,7 @@ pub struct Packed<T: Laned> {
     diffuse: V3<T>,
     /// The exponent of `N·H`, `shininess / 4`.
     exponent: T::Lanes,
-    /// The exponent as a whole number, where [`blinn_phong::power`] takes `powi`
+    /// The exponent as a whole number, where [`blinn_phong::power`] takes `whole_power`
     /// ([`whole_exponent`]).
     ///
     /// [`blinn_phong::power`]: crate::shade::blinn_phong::power

@@ -115,8 +115,8 @@ pub fn whole_power<N: Num>(x: N, n: u32) -> N {
     }
 }
 
-/// The exponent `e` as a whole number from 0 to 256, when [`power`] takes `powi`
-/// for it.
+/// The exponent `e` as a whole number from 0 to 256, when [`power`] takes
+/// [`whole_power`] for it.
 #[inline]
 pub fn whole_exponent<T: Real>(e: T) -> Option<u32> {
     let e = e.to_f64();
