@@ -254,8 +254,9 @@ fn the_numbers_the_chapters_quote_are_measured_again() {
     assert_quotes(
         "04",
         &format!(
-            "{} pixels differ by more than one 8-bit step",
-            d.over_one_step
+            "{} pixels differ by more than one 8-bit step ({:.2} % of the image)",
+            d.over_one_step,
+            100.0 * d.over_one_step as f64 / d.pixels as f64
         ),
     );
     let (with, without) = (

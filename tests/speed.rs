@@ -307,6 +307,25 @@ fn the_yardstick_draws_exactly_the_tutorial_settings_image() {
 }
 
 #[test]
+fn the_yardstick_counts_the_rays_the_tutorials_program_casts() {
+    // The same paths as the book's render under --tutorial, counted pixel by pixel.
+    for (w, h) in [(300, 200), (97, 61)] {
+        let scene = common::seed(w, h);
+        let ours = render(&scene, &Settings::tutorial(Stages::ALL), &|_| {});
+        let port = Yardstick::new(&scene).expect("the seed scene has only spheres");
+        let (mut image, mut rays) = (Vec::new(), Vec::new());
+        let total = port.render_into(&mut image, &mut rays);
+        assert_eq!(total, ours.rays.total(), "{w} × {h}");
+        for (i, (r, p)) in rays.iter().zip(&ours.pixels).enumerate() {
+            assert_eq!(*r, p.rays, "pixel {i} at {w} × {h}");
+        }
+    }
+    // TUTORIAL.md's 60,000 + 43,331 + 36,140 rays at 300 × 200.
+    let port = Yardstick::new(&common::seed(300, 200)).unwrap();
+    assert_eq!(port.render_into(&mut Vec::new(), &mut Vec::new()), 139_471);
+}
+
+#[test]
 fn the_yardstick_refuses_a_true_plane() {
     assert!(Yardstick::new(&load("scenes/true-plane.toml", 10, 10)).is_none());
 }

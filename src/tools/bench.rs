@@ -55,6 +55,11 @@ pub struct Report {
     /// Median seconds per frame of the yardstick (absent for a scene with a true
     /// plane, which the tutorial's program cannot draw, or with `--no-yardstick`).
     pub yardstick_median_s: Option<f64>,
+    /// Rays per frame of the yardstick, counted per pixel and summed after the
+    /// frame (its paths are the tutorial's: no early stop).
+    pub yardstick_rays: Option<u64>,
+    /// `yardstick_rays / yardstick_median_s`.
+    pub yardstick_rays_per_s: Option<f64>,
     /// `yardstick_median_s / median_s`: how many times faster raystep is.
     pub yardstick_ratio: Option<f64>,
     /// The other engine (`"book"`, or `"fast"` under `--engine book`).
@@ -116,7 +121,8 @@ pub fn bench(
     // as it renders.
     let spare = RefCell::new(frame.clone());
     let fast_packets = Cell::new(Packets::Off);
-    let mut image = Vec::new();
+    let (mut image, mut yardstick_rays) = (Vec::new(), Vec::new());
+    let yardstick_total = Cell::new(0);
     let mut jobs: Vec<Job> = vec![
         Box::new(|| many.install(|| render_into(scene, settings, &mut frame, &|_| {}))),
         Box::new(|| {
@@ -136,7 +142,9 @@ pub fn bench(
         }));
     }
     if let Some(y) = &yardstick {
-        jobs.push(Box::new(|| many.install(|| y.render_into(&mut image))));
+        jobs.push(Box::new(|| {
+            yardstick_total.set(many.install(|| y.render_into(&mut image, &mut yardstick_rays)))
+        }));
     }
     let mut seconds = vec![Vec::with_capacity(options.runs); jobs.len()];
     for run in 0..=options.runs {
@@ -181,6 +189,8 @@ pub fn bench(
         one_thread_median_s,
         thread_speedup: one_thread_median_s.map(|t| t / median_s),
         yardstick_median_s,
+        yardstick_rays: yardstick_median_s.map(|_| yardstick_total.get()),
+        yardstick_rays_per_s: yardstick_median_s.map(|t| yardstick_total.get() as f64 / t),
         yardstick_ratio: yardstick_median_s.map(|t| t / median_s),
         other_engine: other.engine.name(),
         other_median_s,
@@ -265,8 +275,10 @@ impl Report {
         match (self.yardstick_median_s, self.yardstick_ratio) {
             (Some(t), Some(r)) => {
                 line(format!(
-                    "  yardstick   {t:>9.4} s per frame   (the tutorial's program ported plainly, \
-                     {} threads)",
+                    "  yardstick   {t:>9.4} s per frame   {:>7.1} Mpixel/s   {:>7.1} Mray/s   \
+                     (the tutorial's program ported plainly, {} threads)",
+                    f64::from(self.width) * f64::from(self.height) / t / 1e6,
+                    self.yardstick_rays_per_s.unwrap_or(f64::NAN) / 1e6,
                     self.threads
                 ));
                 let other = self.other_yardstick_ratio.unwrap_or(f64::NAN);

@@ -56,13 +56,15 @@ impl Yardstick {
         }
         let camera = scene.camera();
         let s = camera.screen;
+        // numpy's linspace: a + i·step, and the last value exactly b.
         let linspace = |a: f64, b: f64, n: u32| -> Vec<f64> {
             if n < 2 {
                 return vec![a];
             }
-            (0..n)
-                .map(|i| a + f64::from(i) * (b - a) / f64::from(n - 1))
-                .collect()
+            let step = (b - a) / f64::from(n - 1);
+            let mut values: Vec<f64> = (0..n).map(|i| a + f64::from(i) * step).collect();
+            values[n as usize - 1] = b;
+            values
         };
         let l = &scene.light;
         Some(Yardstick {
@@ -77,19 +79,28 @@ impl Yardstick {
 
     /// The image, row by row from the top, each pixel clipped to [0, 1].
     pub fn render(&self) -> Vec<DVec3> {
-        let mut image = Vec::new();
-        self.render_into(&mut image);
+        let (mut image, mut rays) = (Vec::new(), Vec::new());
+        self.render_into(&mut image, &mut rays);
         image
     }
 
-    /// [`Yardstick::render`] into `image`, resized to fit: rayon over pixels.
-    pub fn render_into(&self, image: &mut Vec<DVec3>) {
+    /// [`Yardstick::render`] into `image`, and the rays each pixel traced into
+    /// `rays`, both resized to fit: rayon over pixels. Returns the frame's rays,
+    /// summed after the frame (a counter shared by the threads would make them
+    /// wait on each other).
+    pub fn render_into(&self, image: &mut Vec<DVec3>, rays: &mut Vec<u32>) -> u64 {
         let width = self.xs.len();
-        image.resize(width * self.ys.len(), DVec3::ZERO);
+        let pixels = width * self.ys.len();
+        image.resize(pixels, DVec3::ZERO);
+        rays.resize(pixels, 0);
         image
             .par_iter_mut()
+            .zip(rays.par_iter_mut())
             .enumerate()
-            .for_each(|(i, pixel)| *pixel = self.pixel(self.ys[i / width], self.xs[i % width]));
+            .for_each(|(i, (pixel, rays))| {
+                (*pixel, *rays) = self.pixel(self.ys[i / width], self.xs[i % width]);
+            });
+        rays.iter().map(|&r| u64::from(r)).sum()
     }
 
     fn sphere_intersect(
@@ -123,13 +134,17 @@ impl Yardstick {
         nearest
     }
 
-    fn pixel(&self, y: f64, x: f64) -> DVec3 {
+    /// The colour of the pixel looking at screen point (`x`, `y`), and the rays
+    /// it traced.
+    fn pixel(&self, y: f64, x: f64) -> (DVec3, u32) {
         let [light, la, ld, ls] = self.light;
+        let mut rays = 1;
         let mut origin = self.camera;
         let mut direction = (DVec3::new(x, y, 0.0) - origin).normalize();
         let mut colour = DVec3::ZERO;
         let mut reflection = 1.0;
-        for _ in 0..self.max_depth {
+        for depth in 0..self.max_depth {
+            rays += u32::from(depth > 0);
             let Some((i, distance)) = self.nearest_intersected_object(origin, direction) else {
                 break;
             };
@@ -139,6 +154,7 @@ impl Yardstick {
             let shifted = intersection + 1e-5 * normal;
             let to_light = (light - shifted).normalize();
             let light_distance = (light - intersection).length();
+            rays += 1;
             let is_shadowed = self
                 .nearest_intersected_object(shifted, to_light)
                 .is_some_and(|(_, t)| t < light_distance);
@@ -155,6 +171,6 @@ impl Yardstick {
             origin = shifted;
             direction = direction - 2.0 * direction.dot(normal) * normal;
         }
-        colour.clamp(DVec3::ZERO, DVec3::ONE)
+        (colour.clamp(DVec3::ZERO, DVec3::ONE), rays)
     }
 }
