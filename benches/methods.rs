@@ -146,8 +146,7 @@ fn intersect<T: Real>(bencher: Bencher, method: &str) {
 fn bvh_build(bencher: Bencher, count: usize) {
     let scene = raystep::tools::generate::scene(count, 1);
     let objects: Vec<raystep::scene::Object> = scene.objects_in_play(Stages::ALL);
-    let extent = raystep::render::extent(&scene);
-    bencher.bench(|| raystep::bvh::Bvh::build(&objects, extent));
+    bencher.bench(|| raystep::bvh::Bvh::build(&objects));
 }
 
 /// The nearest hit of 4,096 primary rays among N generated spheres: the plain
@@ -168,7 +167,7 @@ fn nearest_hit_list(bencher: Bencher, count: usize) {
 #[divan::bench(args = [4, 8, 12, 16, 32, 1_000, 100_000])]
 fn nearest_hit_bvh(bencher: Bencher, count: usize) {
     let (objects, rays) = spheres_and_rays(count);
-    let bvh = raystep::bvh::Bvh::build(&objects, 100.0);
+    let bvh = raystep::bvh::Bvh::build(&objects);
     bencher.bench(|| {
         rays.iter()
             .filter(|r| {

@@ -23,6 +23,15 @@
 //! float64 lanes, unless a ray starts too far out (`Bvh::enter_packet`, in
 //! `src/fast/walk.rs`). A node is
 //! 32 bytes, two to a cache line.
+//!
+//! **Rounding of the sphere test.** In the precision the render computes in, the
+//! intersection test can report a hit for a ray that passes a little outside a
+//! sphere, by up to a few roundings of the numbers it subtracts: the ray's origin
+//! and the sphere's centre. So each ray tests the boxes widened by a margin of
+//! [`MARGIN`]`·u·(|O| + S)`, with `|O|` its origin's largest coordinate and `S` the
+//! largest coordinate of any sphere's box ([`Bvh::margin`]). The margin is the
+//! ray's own: a scene's far-away floor, whose size has nothing to do with the
+//! numbers a ray and a small sphere are tested with, does not widen every box.
 
 use crate::ray::Ray;
 use crate::real::{Real, Vector};
@@ -63,6 +72,24 @@ pub struct Bvh {
     /// the boxes in float32: twice the largest coordinate of the root box (rounded
     /// down to float32).
     pub(crate) fast_reach: f32,
+    /// The largest coordinate of any sphere's box (`S` of [`Bvh::margin`]).
+    pub(crate) size: f64,
+}
+
+/// How far outside a sphere its intersection test may report a hit, in units of
+/// `u·(|O| + S)` (see [`Bvh::margin`]): a generous multiple of the few roundings
+/// of `m = C − O` and of `‖h·d − m‖²` that decide a hit.
+pub const MARGIN: f64 = 64.0;
+
+/// A ray as the slab test sees it: its origin moved by the ray's margin towards
+/// the low faces (`to_min`) and towards the high ones (`to_max`), so that the
+/// test is of the box widened by the margin on every side, and the reciprocal of
+/// its direction.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Slabs {
+    to_min: Vec3,
+    to_max: Vec3,
+    inverse: Vec3,
 }
 
 /// How much farther than their float64 boxes the stored boxes reach, in units of
@@ -82,23 +109,21 @@ struct Item {
 }
 
 impl Bvh {
-    /// Build the hierarchy over the `[[sphere]]` objects of `objects`. `extent`
-    /// is the largest coordinate any ray may start from or reach (the camera, the
-    /// light, every object): boxes are widened by 64·u·`extent`, more than the
-    /// rounding of the stable intersection test in precision `T` can move a hit,
-    /// and then by what the packet walk's float32 test needs (`FAST_PAD`).
-    /// (The textbook quadratic's rounding can report hits far outside a sphere; a
-    /// box would hide them and change the picture, so the tracer uses no BVH with
-    /// `--intersect naive`.)
-    pub fn build<T: Real>(objects: &[Object<T>], extent: f64) -> Bvh {
+    /// Build the hierarchy over the `[[sphere]]` objects of `objects`, each box
+    /// widened by what the packet walk's float32 test needs (`FAST_PAD`). The
+    /// rounding of the intersection test in precision `T` is each ray's margin
+    /// ([`Bvh::margin`]), added when the ray tests a box. (The textbook
+    /// quadratic's rounding can report hits far outside a sphere; a box would hide
+    /// them and change the picture, so the tracer uses no BVH with `--intersect
+    /// naive`.)
+    pub fn build<T: Real>(objects: &[Object<T>]) -> Bvh {
         let mut items = Vec::with_capacity(objects.len());
         let mut loose = Vec::new();
-        let pad = 64.0 * T::UNIT_ROUNDOFF.to_f64() * extent;
         for (i, o) in objects.iter().enumerate() {
             match o.shape {
                 Shape::Sphere(s) if o.role == Role::Sphere => {
                     let (c, r) = (s.center.to_f64(), s.radius.to_f64());
-                    let half = Vec3::splat(r + pad + 1e-9 * (r + c.abs().max_element()));
+                    let half = Vec3::splat(r + 1e-9 * (r + c.abs().max_element()));
                     items.push(Item {
                         index: i as u32,
                         min: c - half,
@@ -124,6 +149,7 @@ impl Bvh {
             balls: Vec::with_capacity(items.len()),
             loose,
             fast_reach,
+            size: largest,
         };
         let widen = FAST_PAD * f64::from(f32::EPSILON / 2.0) * reach;
         if !items.is_empty() {
@@ -191,12 +217,34 @@ impl Bvh {
             + self.balls.capacity() * std::mem::size_of::<[f64; 4]>()
     }
 
-    // ANCHOR: enter
-    /// Where `ray` enters the box of `node`, if it does before `limit`.
+    /// How much wider than its spheres' boxes a ray from `origin` must see them,
+    /// computing in a precision of unit roundoff `u`: [`MARGIN`]`·u·(|O| + S)`,
+    /// with `|O|` the origin's largest coordinate and `S` the largest of any box.
+    /// (The numbers a sphere test subtracts are at most that large.)
     #[inline]
-    fn enter(node: &Node, origin: Vec3, inverse: Vec3, limit: f64) -> Option<f64> {
-        let t1 = (node.min.as_dvec3() - origin) * inverse;
-        let t2 = (node.max.as_dvec3() - origin) * inverse;
+    pub fn margin(&self, u: f64, origin: Vec3) -> f64 {
+        MARGIN * u * (origin.abs().max_element() + self.size)
+    }
+
+    /// `ray` as the slab test sees it, computing in precision `T`.
+    #[inline]
+    fn slabs<T: Real>(&self, ray: &Ray<T>) -> Slabs {
+        let origin = ray.origin.to_f64();
+        let margin = Vec3::splat(self.margin(T::UNIT_ROUNDOFF.to_f64(), origin));
+        Slabs {
+            to_min: origin + margin,
+            to_max: origin - margin,
+            inverse: Vec3::ONE / ray.direction.to_f64(),
+        }
+    }
+
+    // ANCHOR: enter
+    /// Where a ray enters the box of `node`, widened by its margin, if it does
+    /// before `limit`.
+    #[inline]
+    fn enter(node: &Node, ray: &Slabs, limit: f64) -> Option<f64> {
+        let t1 = (node.min.as_dvec3() - ray.to_min) * ray.inverse;
+        let t2 = (node.max.as_dvec3() - ray.to_max) * ray.inverse;
         // A direction component of 0 makes that axis's slab ±∞ (the ray is inside
         // the slab for ever, or never); `f64::min` and `max` skip the NaN of
         // 0 · ∞, a ray exactly in a face plane.
@@ -224,13 +272,12 @@ impl Bvh {
         if self.nodes.is_empty() {
             return nearest;
         }
-        let origin = ray.origin.to_f64();
-        let inverse = Vec3::ONE / ray.direction.to_f64();
+        let slabs = &self.slabs(ray);
         let mut stack = [0u32; 64];
         let mut depth = 0;
         let mut node = 0usize;
         let limit = |n: &Option<Hit<T>>| n.map_or(f64::INFINITY, |h| h.t.to_f64());
-        if Self::enter(&self.nodes[0], origin, inverse, f64::INFINITY).is_none() {
+        if Self::enter(&self.nodes[0], slabs, f64::INFINITY).is_none() {
             return nearest;
         }
         loop {
@@ -249,8 +296,8 @@ impl Bvh {
                 // ANCHOR: descend
                 let bound = limit(&nearest);
                 let (a, b) = (node + 1, n.first as usize);
-                let ta = Self::enter(&self.nodes[a], origin, inverse, bound);
-                let tb = Self::enter(&self.nodes[b], origin, inverse, bound);
+                let ta = Self::enter(&self.nodes[a], slabs, bound);
+                let tb = Self::enter(&self.nodes[b], slabs, bound);
                 match (ta, tb) {
                     (Some(ta), Some(tb)) => {
                         let (near, far) = if ta <= tb { (a, b) } else { (b, a) };
@@ -279,7 +326,7 @@ impl Bvh {
                 depth -= 1;
                 let candidate = stack[depth] as usize;
                 let bound = limit(&nearest);
-                if Self::enter(&self.nodes[candidate], origin, inverse, bound).is_some() {
+                if Self::enter(&self.nodes[candidate], slabs, bound).is_some() {
                     node = candidate;
                     break;
                 }
@@ -307,12 +354,11 @@ impl Bvh {
         if self.nodes.is_empty() {
             return false;
         }
-        let origin = ray.origin.to_f64();
-        let inverse = Vec3::ONE / ray.direction.to_f64();
+        let slabs = &self.slabs(ray);
         let bound = distance.to_f64();
         let mut stack = [0u32; 64];
         let mut depth = 0;
-        if Self::enter(&self.nodes[0], origin, inverse, bound).is_none() {
+        if Self::enter(&self.nodes[0], slabs, bound).is_none() {
             return false;
         }
         let mut node = 0usize;
@@ -324,8 +370,8 @@ impl Bvh {
                 }
             } else {
                 let (a, b) = (node + 1, n.first as usize);
-                let ta = Self::enter(&self.nodes[a], origin, inverse, bound).is_some();
-                let tb = Self::enter(&self.nodes[b], origin, inverse, bound).is_some();
+                let ta = Self::enter(&self.nodes[a], slabs, bound).is_some();
+                let tb = Self::enter(&self.nodes[b], slabs, bound).is_some();
                 if ta && tb {
                     stack[depth] = b as u32;
                     depth += 1;
@@ -403,7 +449,7 @@ mod tests {
                 )
             })
             .collect();
-        let bvh = Bvh::build(&objects, 100.0);
+        let bvh = Bvh::build(&objects);
         let mut seen = bvh.items.clone();
         seen.sort_unstable();
         assert_eq!(seen, (0..1000).collect::<Vec<u32>>());
@@ -424,13 +470,35 @@ mod tests {
         let objects: Vec<Object> = (0..100)
             .map(|i| ball(0.0, 0.0, -f64::from(i) - 2.0, 0.4))
             .collect();
-        let bvh = Bvh::build(&objects, 100.0);
+        let bvh = Bvh::build(&objects);
         let ray = Ray::towards(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0));
         let hit = bvh.nearest_hit(&objects, &ray, Method::Stable).unwrap();
         assert_eq!(hit.object, 0);
         assert!((hit.t - 1.6).abs() < 1e-12);
         assert!(bvh.blocked(&objects, &ray, 1.7, Method::Stable));
         assert!(!bvh.blocked(&objects, &ray, 1.5, Method::Stable));
+    }
+
+    #[test]
+    fn the_margin_is_the_rays_own_and_a_far_floor_does_not_widen_it() {
+        let spheres: Vec<Object> = (0..100)
+            .map(|i| ball(f64::from(i % 10), 0.0, -f64::from(i / 10) - 2.0, 0.01))
+            .collect();
+        let mut with_floor = spheres.clone();
+        with_floor.push(Object {
+            role: Role::Floor,
+            ..ball(0.0, -9000.0, 0.0, 8999.3)
+        });
+        let (bare, floored) = (Bvh::build(&spheres), Bvh::build(&with_floor));
+        assert_eq!(bare.size, floored.size);
+        assert_eq!(floored.loose, vec![100]);
+        // In float32, from the camera: a small fraction of a sphere's radius.
+        let u = f64::from(f32::EPSILON) / 2.0;
+        let near = floored.margin(u, Vec3::new(0.0, 0.0, 1.0));
+        assert!(near < 0.01 / 10.0, "{near}");
+        // From a point far out on the floor, larger in proportion.
+        let far = floored.margin(u, Vec3::new(0.0, 0.0, 1000.0));
+        assert!(far > 50.0 * near, "{far} {near}");
     }
 
     #[test]

@@ -214,7 +214,7 @@ impl<T: Real> Tracer<T> {
             offset: settings.offset,
             viewer: settings.viewer,
             camera: scene.camera(),
-            bvh: tree.then(|| Bvh::build(&objects, extent(scene))),
+            bvh: tree.then(|| Bvh::build(&objects)),
             objects,
             light: scene.light.cast(),
             max_depth: scene.max_depth,
@@ -374,17 +374,6 @@ impl<T: Real> Tracer<T> {
         // ANCHOR_END: accumulate
     }
     // ANCHOR_END: trace
-}
-
-/// The largest coordinate a ray of `scene` can start from or reach: the camera,
-/// the light, and every object's size ([`Object::magnitude`]).
-pub fn extent(scene: &Scene) -> f64 {
-    scene
-        .objects
-        .iter()
-        .map(Object::magnitude)
-        .fold(scene.camera.abs().max_element(), f64::max)
-        .max(scene.light.position.abs().max_element())
 }
 
 // ANCHOR: reach

@@ -3,7 +3,7 @@
 //! [`PacketSearch`] to test the objects of the leaves they enter. It finds, lane
 //! by lane, what the book's one-ray walk ([`Bvh::nearest_hit`]) finds.
 
-use crate::bvh::{Bvh, Node};
+use crate::bvh::{Bvh, Node, MARGIN};
 use crate::fast::lanes::{convert, F32s, F64s, Laned, Lanes, ALL, V3};
 
 /// What a search for objects along a packet's rays asks of them: the tree's walk
@@ -22,7 +22,9 @@ pub trait PacketSearch {
 impl Bvh {
     // ANCHOR: enter_packet
     /// [`Bvh::enter`] for four rays at once, in precision `L`: where each enters
-    /// the box of `node`, and the lanes that enter it before their limit.
+    /// the box of `node`, widened by its margin, and the lanes that enter it
+    /// before their limit. `to_min` and `to_max` are the origins moved by each
+    /// lane's margin towards the low and the high faces ([`Bvh::margin`]).
     ///
     /// In float32 the origin, the direction, its reciprocal and each step of the
     /// slab test round, and a box might seem missed by a ray that grazes it. The
@@ -47,19 +49,19 @@ impl Bvh {
     #[inline(always)]
     fn enter_packet<L: Laned>(
         node: &Node,
-        origin: &V3<L>,
+        [to_min, to_max]: &[V3<L>; 2],
         inverse: &V3<L>,
         limit: L::Lanes,
     ) -> (L::Lanes, u32) {
-        let slab = |min: f32, max: f32, o: L::Lanes, inv: L::Lanes| {
+        let slab = |min: f32, max: f32, lo: L::Lanes, hi: L::Lanes, inv: L::Lanes| {
             let face = |b: f32| L::Lanes::splat(L::of(f64::from(b)));
-            let t1 = (face(min) - o) * inv;
-            let t2 = (face(max) - o) * inv;
+            let t1 = (face(min) - lo) * inv;
+            let t2 = (face(max) - hi) * inv;
             (t1.fast_min(t2), t1.fast_max(t2))
         };
-        let (nx, fx) = slab(node.min.x, node.max.x, origin.x, inverse.x);
-        let (ny, fy) = slab(node.min.y, node.max.y, origin.y, inverse.y);
-        let (nz, fz) = slab(node.min.z, node.max.z, origin.z, inverse.z);
+        let (nx, fx) = slab(node.min.x, node.max.x, to_min.x, to_max.x, inverse.x);
+        let (ny, fy) = slab(node.min.y, node.max.y, to_min.y, to_max.y, inverse.y);
+        let (nz, fz) = slab(node.min.z, node.max.z, to_min.z, to_max.z, inverse.z);
         let near = nx
             .fast_max(ny)
             .fast_max(nz)
@@ -75,8 +77,8 @@ impl Bvh {
     /// searching enters before its limit. A lane's result is the one-ray walk's,
     /// because a lane skips only boxes that cannot hold a hit as near as its
     /// limit; objects it did not need are tested too, and cannot come nearer. The
-    /// boxes are tested in float32 when every origin lies within
-    /// `Bvh::fast_reach` (see `Bvh::enter_packet`), in float64 otherwise.
+    /// boxes are tested in float32 when every origin, moved by its margin, lies
+    /// within `Bvh::fast_reach` (see `Bvh::enter_packet`), in float64 otherwise.
     #[inline(always)]
     pub fn search_packet<T: Laned, S: PacketSearch>(
         &self,
@@ -90,13 +92,19 @@ impl Bvh {
         if self.nodes.is_empty() {
             return;
         }
-        let reach = T::Lanes::splat(T::of(f64::from(self.fast_reach)));
-        if reach.ge(origin.max_abs()).bits() == ALL {
-            let (o, d) = (origin.convert::<f32>(), direction.convert::<f32>());
-            self.walk(&o, &d, search, up_to_f32);
+        // Each lane's margin (`Bvh::margin`), in float64.
+        let o = origin.convert::<f64>();
+        let u = F64s::splat(MARGIN * T::UNIT_ROUNDOFF.to_f64());
+        let margin = u * (o.max_abs() + F64s::splat(self.size));
+        let margin = V3::new(margin, margin, margin);
+        let moved = [o + margin, o - margin];
+        let reach = F64s::splat(f64::from(self.fast_reach));
+        let within = reach.ge(moved[0].max_abs()) & reach.ge(moved[1].max_abs());
+        if within.bits() == ALL {
+            let moved = moved.map(|o| o.convert::<f32>());
+            self.walk(&moved, &direction.convert::<f32>(), search, up_to_f32);
         } else {
-            let (o, d) = (origin.convert::<f64>(), direction.convert::<f64>());
-            self.walk(&o, &d, search, |l| l);
+            self.walk(&moved, &direction.convert::<f64>(), search, |l| l);
         }
     }
     // ANCHOR_END: search_packet
@@ -106,7 +114,7 @@ impl Bvh {
     #[inline(always)]
     fn walk<L: Laned, S: PacketSearch>(
         &self,
-        origin: &V3<L>,
+        origins: &[V3<L>; 2],
         direction: &V3<L>,
         search: &mut S,
         limits_in: impl Fn(F64s) -> L::Lanes,
@@ -118,7 +126,7 @@ impl Bvh {
         // objects are tested.
         let limits = |search: &S| (search.active(), limits_in(search.limits()));
         let enters = |node: usize, (active, limit): (u32, L::Lanes)| {
-            let (near, bits) = Self::enter_packet(&self.nodes[node], origin, inverse, limit);
+            let (near, bits) = Self::enter_packet(&self.nodes[node], origins, inverse, limit);
             (near, bits & active)
         };
         let mut now = limits(search);
@@ -249,7 +257,7 @@ mod tests {
             let c = Vec3::from(centre) * s * 10f64.powf(far);
             let r = s * size;
             let objects = [ball(c.x, c.y, c.z, r)];
-            let bvh = Bvh::build(&objects, c.abs().max_element() + r);
+            let bvh = Bvh::build(&objects);
             // A point on the sphere's tight box: on a face, an edge or a corner.
             let (min, max) = (c - r, c + r);
             let mut p = min + (max - min) * Vec3::from(on);
@@ -275,13 +283,13 @@ mod tests {
             let inverse = V3::new(one / d.x, one / d.y, one / d.z);
             // The tightest limit: the exact ray's own entry distance.
             let limit = up_to_f32(F64s::splat(t));
-            let (near, bits) = Bvh::enter_packet(&bvh.nodes[0], &o, &inverse, limit);
+            let (near, bits) = Bvh::enter_packet(&bvh.nodes[0], &[o, o], &inverse, limit);
             proptest::prop_assert_eq!(bits, ALL, "t = {}", t);
             proptest::prop_assert!(f64::from(near.to_array()[0]) <= t);
             // The float64 lanes, which rays from farther away take, too.
             let wide = |v: Vec3| V3::<f64>::splat(v);
             let (o, inverse) = (wide(origin), wide(Vec3::ONE / direction));
-            let (near, bits) = Bvh::enter_packet(&bvh.nodes[0], &o, &inverse, F64s::splat(t));
+            let (near, bits) = Bvh::enter_packet(&bvh.nodes[0], &[o, o], &inverse, F64s::splat(t));
             proptest::prop_assert_eq!(bits, ALL, "t = {}", t);
             proptest::prop_assert!(near.to_array()[0] <= t);
         }

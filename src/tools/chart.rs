@@ -285,7 +285,7 @@ pub fn scale(
         (scene.width, scene.height) = (width, height);
         let objects: Vec<crate::scene::Object> = scene.objects_in_play(Stages::ALL);
         let start = Instant::now();
-        let bvh = crate::bvh::Bvh::build(&objects, crate::render::extent(&scene));
+        let bvh = crate::bvh::Bvh::build(&objects);
         let build_s = start.elapsed().as_secs_f64();
         for accel in [Accel::Auto, Accel::Off] {
             if accel == Accel::Off && count > plain_up_to {
