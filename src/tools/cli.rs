@@ -123,6 +123,10 @@ pub enum Command {
     /// (or, with --scale, time against the number of spheres): a CSV, an SVG and a
     /// PNG. Default: the built-in scene at 960 × 540.
     Chart(ChartArgs),
+    /// Serve a live page on 127.0.0.1 to switch stages, pick buffers and read any
+    /// pixel's story, re-rendered on demand; the scene file is watched. Also an
+    /// HTTP API (see the README). Runs until Ctrl-C.
+    Serve(crate::tools::serve::ServeArgs),
 }
 
 /// Arguments of `raystep explain`.
@@ -395,6 +399,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Some(Command::Accuracy(args)) => accuracy(&args),
         Some(Command::Bench(args)) => bench(args),
         Some(Command::Chart(args)) => chart(args),
+        Some(Command::Serve(args)) => crate::tools::serve::run(&args),
         Some(Command::Generate(args)) => match args.what {
             Generated::Spheres { count, seed } => {
                 let text = crate::tools::generate::spheres_toml(count as usize, seed);
@@ -416,7 +421,7 @@ impl StagesArgs {
 
 impl RuleArgs {
     /// The settings for `stages` under these rules; a `--max-depth` goes into `scene`.
-    fn apply(&self, scene: &mut Scene, stages: Stages) -> Result<Settings, Error> {
+    pub fn apply(&self, scene: &mut Scene, stages: Stages) -> Result<Settings, Error> {
         if let Some(depth) = self.max_depth {
             check_max_depth(depth, "--max-depth").map_err(Error::Usage)?;
             scene.max_depth = depth;
@@ -577,15 +582,7 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
 fn explain(args: &ExplainArgs) -> Result<(), Error> {
     let (scene, settings) = prepare(&args.frame)?;
     let (x, y) = args.pixel;
-    if x >= scene.width || y >= scene.height {
-        return Err(Error::Usage(format!(
-            "--pixel {x},{y} is outside the {} × {} image: x runs from 0 to {} and y from 0 to {}",
-            scene.width,
-            scene.height,
-            scene.width - 1,
-            scene.height - 1
-        )));
-    }
+    check_pixel(&scene, x, y)?;
     let story = crate::tools::explain::explain(&scene, &settings, x, y);
     if args.json {
         let json = serde_json::to_string_pretty(&story).expect("an explanation is plain data");
@@ -598,6 +595,20 @@ fn explain(args: &ExplainArgs) -> Result<(), Error> {
             scene.height
         );
         say!("{story}");
+    }
+    Ok(())
+}
+
+/// Refuse a `--pixel` outside the image of `scene`.
+pub fn check_pixel(scene: &Scene, x: u32, y: u32) -> Result<(), Error> {
+    if x >= scene.width || y >= scene.height {
+        return Err(Error::Usage(format!(
+            "--pixel {x},{y} is outside the {} × {} image: x runs from 0 to {} and y from 0 to {}",
+            scene.width,
+            scene.height,
+            scene.width - 1,
+            scene.height - 1
+        )));
     }
     Ok(())
 }

@@ -9,4 +9,5 @@ pub mod compare;
 pub mod explain;
 pub mod figures;
 pub mod generate;
+pub mod serve;
 pub mod yardstick;

@@ -1,0 +1,562 @@
+//! What the studio's HTTP API answers, apart from HTTP itself: the scene it
+//! serves (and watches), and the query strings of `/api/render` and `/api/pixel`
+//! turned into the command line's own arguments.
+//!
+//! A query is read as the flags of `raystep render` (or `explain`) without their
+//! dashes: `stage=shadow&without=blinn-phong&width=300` becomes the words
+//! `--stage=shadow --without=blinn-phong --width=300`, parsed by the command
+//! line's own clap parser, so a mistake gets the message the command line gives.
+//! A key with no value (`tutorial` or `tutorial=`) is a flag without one. The
+//! scene is always the one served: no query names a file.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::time::{Duration, SystemTime};
+
+use clap::Parser;
+use serde_json::{json, Value};
+
+use crate::aov::Buffer;
+use crate::error::Error;
+use crate::io::scene_file::{self, SizeOverride};
+use crate::render::Settings;
+use crate::scene::{Role, Scene, Shape};
+use crate::stages::Stages;
+use crate::tools::cli::{check_pixel, Cli, Command, FrameArgs};
+
+/// The longest query string taken, in bytes (a page's query is a few hundred).
+pub const MAX_QUERY_BYTES: usize = 4096;
+
+/// The most `key=value` pairs in one query.
+pub const MAX_QUERY_PAIRS: usize = 64;
+
+/// A request the API refuses: the HTTP status and the message (for a bad
+/// option, the command line's own).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Refusal {
+    /// 400 for a mistake in the query.
+    pub status: u16,
+    /// What is wrong, as the command line says it.
+    pub message: String,
+}
+
+impl Refusal {
+    fn bad(message: impl Into<String>) -> Refusal {
+        Refusal {
+            status: 400,
+            message: message.into(),
+        }
+    }
+
+    /// The body of the answer: `{"error": "..."}`.
+    pub fn json(&self) -> String {
+        json!({ "error": self.message }).to_string()
+    }
+}
+
+impl From<Error> for Refusal {
+    fn from(error: Error) -> Refusal {
+        Refusal::bad(error.to_string())
+    }
+}
+
+/// A clap error as the command line prints it (without its leading `error: `).
+fn clap_message(error: &clap::Error) -> String {
+    let text = error.to_string();
+    let text = text.trim_end();
+    text.strip_prefix("error: ").unwrap_or(text).to_string()
+}
+
+/// The words of the command line that `query` stands for (each `--key=value`, or
+/// `--key`), and the values of the keys in `taken`, which the endpoint reads
+/// itself (each at most once), in the order of `taken`.
+pub fn query_words(
+    query: &str,
+    taken: &[&str],
+) -> Result<(Vec<String>, Vec<Option<String>>), Refusal> {
+    if query.len() > MAX_QUERY_BYTES {
+        return Err(Refusal::bad(format!(
+            "the query is {} bytes long; at most {MAX_QUERY_BYTES} are taken",
+            query.len()
+        )));
+    }
+    let mut words = Vec::new();
+    let mut values: Vec<Option<String>> = vec![None; taken.len()];
+    for (n, (key, value)) in form_urlencoded::parse(query.as_bytes()).enumerate() {
+        if n >= MAX_QUERY_PAIRS {
+            return Err(Refusal::bad(format!(
+                "the query has more than {MAX_QUERY_PAIRS} keys"
+            )));
+        }
+        if key.is_empty() && value.is_empty() {
+            continue;
+        }
+        if let Some(i) = taken.iter().position(|t| *t == key) {
+            if values[i].is_some() {
+                return Err(Refusal::bad(format!("`{key}` is given more than once")));
+            }
+            values[i] = Some(value.into_owned());
+            continue;
+        }
+        let well_formed = key.len() <= 32
+            && key.starts_with(|c: char| c.is_ascii_lowercase())
+            && key
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-');
+        if !well_formed {
+            return Err(Refusal::bad(format!(
+                "`{key}` is not an option: the query's keys are the command line's flags \
+                 without their dashes, e.g. stage=shadow&without=blinn-phong&width=300"
+            )));
+        }
+        if ["help", "version", "out"].contains(&key.as_ref()) {
+            return Err(Refusal::bad(format!(
+                "`{key}` is not an option of the API: it renders into its answer, and writes \
+                 and prints nothing"
+            )));
+        }
+        words.push(if value.is_empty() {
+            format!("--{key}")
+        } else {
+            format!("--{key}={value}")
+        });
+    }
+    Ok((words, values))
+}
+
+/// Parse `raystep WORDS` with the command line's parser.
+fn parse_command(words: Vec<String>) -> Result<Command, Refusal> {
+    let cli = Cli::try_parse_from(std::iter::once("raystep".to_string()).chain(words))
+        .map_err(|e| Refusal::bad(clap_message(&e)))?;
+    cli.command
+        .ok_or_else(|| Refusal::bad("no command".to_string()))
+}
+
+/// Where the served scene comes from.
+#[derive(Clone, Debug)]
+enum Source {
+    BuiltIn,
+    File(PathBuf),
+}
+
+/// A scene file as last seen on the disk: enough to notice a change.
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct Stamp {
+    modified: Option<SystemTime>,
+    len: u64,
+    inode: u64,
+}
+
+fn stamp(path: &Path) -> Option<Stamp> {
+    use std::os::unix::fs::MetadataExt;
+    let m = std::fs::metadata(path).ok()?;
+    Some(Stamp {
+        modified: m.modified().ok(),
+        len: m.len(),
+        inode: m.ino(),
+    })
+}
+
+/// What the studio serves, behind its lock.
+struct Served {
+    /// Grows by one on every reload, good or bad; 1 for the first load.
+    version: u64,
+    /// The text of the last scene that loaded, and its name in messages.
+    text: Arc<str>,
+    /// The last scene that loaded, at its own size.
+    scene: Arc<Scene>,
+    /// Why the latest reload failed, if it did (the scene is then the last good).
+    error: Option<String>,
+    /// The file as last seen, and its bytes as last read (good or not).
+    stamp: Option<Stamp>,
+    /// A change seen at the last look, read once the file stays as it is for
+    /// one more look (an editor that truncates and then writes is not read in
+    /// between).
+    settling: Option<Option<Stamp>>,
+    bytes: Option<Vec<u8>>,
+    /// Scenes parsed at other sizes, for this version: (width, height, scene).
+    sized: Vec<(SizeOverride, Arc<Scene>)>,
+    /// The server is stopping: waiters leave.
+    stopping: bool,
+}
+
+/// The scene being served: the built-in one, or a file watched for changes.
+pub struct Studio {
+    source: Source,
+    name: String,
+    served: Mutex<Served>,
+    changed: Condvar,
+}
+
+/// How many scenes at other sizes are kept parsed.
+const SIZED_KEPT: usize = 4;
+
+/// The file's bytes as `scene_file::load` would read them (at most its limit),
+/// or `None` if it would refuse them for their size, encoding, or a failure to
+/// read.
+fn read_bytes(path: &Path) -> Option<Vec<u8>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .ok()?
+        .take(scene_file::MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .ok()?;
+    Some(bytes)
+}
+
+impl Studio {
+    /// Serve the scene file at `path` (or the built-in scene): refused, with the
+    /// command line's message, if it does not load now.
+    pub fn open(path: Option<&Path>) -> Result<Studio, Error> {
+        let (source, name) = match path {
+            None => (Source::BuiltIn, scene_file::SEED_NAME.to_string()),
+            Some(p) => (Source::File(p.to_path_buf()), p.display().to_string()),
+        };
+        let (text, bytes, stamp) = match &source {
+            Source::BuiltIn => (scene_file::SEED_TOML.to_string(), None, None),
+            Source::File(p) => {
+                let stamp = stamp(p);
+                let bytes = read_bytes(p);
+                let text = Studio::text_of(p, bytes.as_deref())?;
+                (text, bytes, stamp)
+            }
+        };
+        let scene = scene_file::parse(&text, &name)?;
+        let served = Served {
+            version: 1,
+            text: text.into(),
+            scene: Arc::new(scene),
+            error: None,
+            stamp,
+            settling: None,
+            bytes,
+            sized: Vec::new(),
+            stopping: false,
+        };
+        Ok(Studio {
+            source,
+            name,
+            served: Mutex::new(served),
+            changed: Condvar::new(),
+        })
+    }
+
+    /// The text of a scene file read as `bytes`, or the command line's message
+    /// for a file it cannot take (too large, not UTF-8, unreadable).
+    fn text_of(path: &Path, bytes: Option<&[u8]>) -> Result<String, Error> {
+        match bytes.map(std::str::from_utf8) {
+            Some(Ok(text)) if text.len() as u64 <= scene_file::MAX_FILE_BYTES => {
+                Ok(text.to_string())
+            }
+            // The command line's own reading says what is wrong.
+            _ => match scene_file::load(path) {
+                Err(e) => Err(e),
+                Ok(_) => Err(Error::Scene {
+                    file: path.display().to_string(),
+                    message: "changed while it was read; it is read again".into(),
+                }),
+            },
+        }
+    }
+
+    fn lock(&self) -> MutexGuard<'_, Served> {
+        self.served.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The scene file's path, if it is not the built-in scene.
+    pub fn path(&self) -> Option<&Path> {
+        match &self.source {
+            Source::BuiltIn => None,
+            Source::File(p) => Some(p),
+        }
+    }
+
+    /// The scene's name in messages: its path, or the built-in scene's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The version now, and the error of the latest reload if it failed.
+    pub fn version(&self) -> (u64, Option<String>) {
+        let served = self.lock();
+        (served.version, served.error.clone())
+    }
+
+    /// Look at the scene file: if it changed since the last look but not since
+    /// the one before, and its bytes differ, load it again (keeping the last
+    /// good scene if it no longer loads), count a new version and wake the
+    /// waiters. Returns whether it reloaded.
+    pub fn poll(&self) -> bool {
+        let Source::File(path) = &self.source else {
+            return false;
+        };
+        let now = stamp(path);
+        {
+            let mut served = self.lock();
+            if now.is_some() && now == served.stamp {
+                served.settling = None;
+                return false;
+            }
+            if served.settling.as_ref() != Some(&now) {
+                served.settling = Some(now);
+                return false;
+            }
+            served.settling = None;
+        }
+        let bytes = read_bytes(path);
+        let mut served = self.lock();
+        served.stamp = now;
+        if bytes == served.bytes {
+            return false;
+        }
+        served.bytes = bytes.clone();
+        drop(served);
+        let loaded = Studio::text_of(path, bytes.as_deref())
+            .and_then(|text| scene_file::parse(&text, &self.name).map(|scene| (text, scene)));
+        let mut served = self.lock();
+        served.version += 1;
+        match loaded {
+            Ok((text, scene)) => {
+                served.text = text.into();
+                served.scene = Arc::new(scene);
+                served.error = None;
+                served.sized.clear();
+            }
+            Err(e) => served.error = Some(e.to_string()),
+        }
+        drop(served);
+        self.changed.notify_all();
+        true
+    }
+
+    /// Wait until the version differs from `seen`, the server stops, or
+    /// `timeout` passes: the version then, its error, and whether it stops.
+    pub fn wait_change(&self, seen: u64, timeout: Duration) -> (u64, Option<String>, bool) {
+        let served = self.lock();
+        let (served, _) = self
+            .changed
+            .wait_timeout_while(served, timeout, |s| s.version == seen && !s.stopping)
+            .unwrap_or_else(|e| e.into_inner());
+        (served.version, served.error.clone(), served.stopping)
+    }
+
+    /// Wake every waiter for good: the server stops.
+    pub fn stop(&self) {
+        self.lock().stopping = true;
+        self.changed.notify_all();
+    }
+
+    /// The last good scene at the size `size` asks for, as the command line
+    /// would load it (the size decides the default screen, so the text is parsed
+    /// again at each size), and the version it belongs to.
+    fn scene_at(&self, size: SizeOverride) -> Result<(Scene, u64), Error> {
+        let (text, version) = {
+            let served = self.lock();
+            if size == SizeOverride::default() {
+                return Ok((Scene::clone(&served.scene), served.version));
+            }
+            if let Some((_, scene)) = served.sized.iter().find(|(s, _)| *s == size) {
+                return Ok((Scene::clone(scene), served.version));
+            }
+            (Arc::clone(&served.text), served.version)
+        };
+        let scene = scene_file::parse_sized(&text, &self.name, size)?;
+        let mut served = self.lock();
+        if served.version == version && Arc::ptr_eq(&served.text, &text) {
+            if served.sized.len() >= SIZED_KEPT {
+                served.sized.remove(0);
+            }
+            served.sized.push((size, Arc::new(scene.clone())));
+        }
+        Ok((scene, version))
+    }
+
+    /// `prepare` of the command line on the served scene: the stages, the scene
+    /// at its size, the rules; in that order, so that the first mistake found is
+    /// the one the command line reports.
+    fn prepare(&self, frame: &FrameArgs) -> Result<(Scene, Settings, u64), Error> {
+        let stages = Stages::select(frame.stage, &frame.without).map_err(Error::Usage)?;
+        let size = SizeOverride {
+            width: frame.scene.width,
+            height: frame.scene.height,
+        };
+        let (mut scene, version) = self.scene_at(size)?;
+        let settings = frame.rules.apply(&mut scene, stages)?;
+        Ok((scene, settings, version))
+    }
+
+    /// `GET /api/render?QUERY`: what to render, or why not.
+    pub fn render_job(&self, query: &str) -> Result<RenderJob, Refusal> {
+        let (words, taken) = query_words(query, &["buffer"])?;
+        let name = taken[0].clone().unwrap_or_else(|| "beauty".to_string());
+        let words = std::iter::once("render".to_string()).chain(words).collect();
+        let Command::Render(args) = parse_command(words)? else {
+            unreachable!("the words begin with `render`")
+        };
+        let (scene, settings, version) = self.prepare(&args.frame)?;
+        let Some(buffer) = Buffer::ALL.into_iter().find(|b| b.name() == name) else {
+            let names: Vec<&str> = Buffer::ALL.iter().map(|b| b.name()).collect();
+            return Err(Refusal::bad(format!(
+                "buffer={name}: no such buffer; the buffers are {}",
+                names.join(", ")
+            )));
+        };
+        if !buffer.written(settings.stages) {
+            return Err(Refusal::bad(format!(
+                "buffer={name}: a render of {} has no {name} buffer; it has {}",
+                settings.stages,
+                buffers_of(settings.stages).join(", ")
+            )));
+        }
+        Ok(RenderJob {
+            scene,
+            settings,
+            buffer,
+            version,
+        })
+    }
+
+    /// `GET /api/pixel?x=X&y=Y&QUERY`: exactly what `raystep explain --pixel X,Y
+    /// QUERY --json` prints, or why not.
+    pub fn pixel(&self, query: &str) -> Result<String, Refusal> {
+        let (words, taken) = query_words(query, &["x", "y"])?;
+        let (Some(x), Some(y)) = (&taken[0], &taken[1]) else {
+            return Err(Refusal::bad(
+                "give the pixel as x=X&y=Y: column and row from the top-left corner",
+            ));
+        };
+        let words = [
+            "explain".to_string(),
+            format!("--pixel={x},{y}"),
+            "--json".into(),
+        ]
+        .into_iter()
+        .chain(words)
+        .collect();
+        let Command::Explain(args) = parse_command(words)? else {
+            unreachable!("the words begin with `explain`")
+        };
+        let (scene, settings, _) = self.prepare(&args.frame)?;
+        let (x, y) = args.pixel;
+        check_pixel(&scene, x, y)?;
+        let story = crate::tools::explain::explain(&scene, &settings, x, y);
+        let json = serde_json::to_string_pretty(&story).expect("an explanation is plain data");
+        Ok(json + "\n")
+    }
+
+    /// `GET /api/scene`: the version, the error of the latest reload (or null),
+    /// and the last good scene.
+    pub fn scene_json(&self) -> Value {
+        let served = self.lock();
+        json!({
+            "version": served.version,
+            "file": self.name,
+            "error": served.error,
+            "scene": describe_scene(&served.scene),
+        })
+    }
+}
+
+/// The names of the buffers a render of `stages` has.
+pub fn buffers_of(stages: Stages) -> Vec<&'static str> {
+    Buffer::ALL
+        .into_iter()
+        .filter(|b| b.written(stages))
+        .map(Buffer::name)
+        .collect()
+}
+
+/// A render the API was asked for, ready to run.
+pub struct RenderJob {
+    /// The scene at the size asked for.
+    pub scene: Scene,
+    /// The stages and rules.
+    pub settings: Settings,
+    /// The buffer whose PNG is the answer.
+    pub buffer: Buffer,
+    /// The scene's version.
+    pub version: u64,
+}
+
+impl RenderJob {
+    /// Pixels in the image.
+    pub fn pixels(&self) -> u64 {
+        u64::from(self.scene.width) * u64::from(self.scene.height)
+    }
+
+    /// Render, and encode the buffer as `raystep render` writes its PNG file.
+    pub fn run(&self) -> Rendered {
+        let start = std::time::Instant::now();
+        let frame = crate::engine::render(&self.scene, &self.settings, &|_| {});
+        let render_seconds = start.elapsed().as_secs_f64();
+        let png = crate::io::output::png_bytes(&frame, self.buffer);
+        Rendered {
+            png,
+            render_seconds,
+            encode_seconds: start.elapsed().as_secs_f64() - render_seconds,
+        }
+    }
+}
+
+/// The answer of a [`RenderJob`].
+pub struct Rendered {
+    /// The PNG file's bytes.
+    pub png: Vec<u8>,
+    /// How long the render took.
+    pub render_seconds: f64,
+    /// How long the PNG took to encode.
+    pub encode_seconds: f64,
+}
+
+/// The scene as JSON: everything `raystep check` describes, as numbers.
+pub fn describe_scene(scene: &Scene) -> Value {
+    let camera = scene.camera();
+    let s = camera.screen;
+    let objects: Vec<Value> = scene
+        .objects
+        .iter()
+        .enumerate()
+        .map(|(index, o)| {
+            let m = &o.material;
+            let material = json!({
+                "ambient": m.ambient.to_array(),
+                "diffuse": m.diffuse.to_array(),
+                "specular": m.specular.to_array(),
+                "shininess": m.shininess,
+                "reflection": m.reflection,
+            });
+            let section = match o.role {
+                Role::Sphere => "sphere",
+                Role::Floor => "plane",
+            };
+            let shape = match o.shape {
+                Shape::Sphere(sp) => json!({
+                    "kind": "sphere", "center": sp.center.to_array(), "radius": sp.radius,
+                }),
+                Shape::Plane(p) => json!({
+                    "kind": "plane", "point": p.point.to_array(), "normal": p.normal.to_array(),
+                }),
+            };
+            json!({ "index": index, "section": section, "shape": shape, "material": material })
+        })
+        .collect();
+    let l = &scene.light;
+    json!({
+        "width": scene.width,
+        "height": scene.height,
+        "camera": scene.camera.to_array(),
+        "screen": {
+            "left": s.left, "right": s.right, "top": s.top, "bottom": s.bottom,
+            "set_by_scene": scene.screen.is_some(),
+        },
+        "light": {
+            "position": l.position.to_array(),
+            "ambient": l.ambient.to_array(),
+            "diffuse": l.diffuse.to_array(),
+            "specular": l.specular.to_array(),
+        },
+        "max_depth": scene.max_depth,
+        "objects": objects,
+    })
+}

@@ -1,0 +1,466 @@
+//! `raystep serve`: the studio, a page on 127.0.0.1 that re-renders on demand,
+//! and the HTTP API it uses ([`api`]).
+//!
+//! HTTP is [tiny_http]'s: a thread per connection that parses requests, and a
+//! few threads here that answer them. Renders are CPU work on rayon's pool, so
+//! nothing is gained from an async runtime; tiny_http and its four small
+//! dependencies build in seconds.
+//!
+//! Safety, since a server is an attack surface:
+//! - it listens on 127.0.0.1 only;
+//! - a request whose `Host` is not `127.0.0.1:PORT` or `localhost:PORT` is
+//!   refused with 421 (a page elsewhere cannot reach it through DNS rebinding),
+//!   and so, with 403, is one a browser marks as sent by another site
+//!   (`Sec-Fetch-Site`);
+//! - the only paths are the page's own files, compiled into the binary, and the
+//!   API: nothing is ever read from the disk for a path, so `/../`, encoded dots
+//!   and absolute paths are 404;
+//! - a query is at most [`api::MAX_QUERY_BYTES`], an image and its samples are
+//!   bounded by the command line's limits, and at most [`RENDERS_AT_ONCE`]
+//!   renders (and [`MAX_PIXELS`] pixels) are in flight: others wait in line, up
+//!   to [`QUEUE_WAIT`], then get 503.
+
+pub mod api;
+
+use std::io::Write;
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::{Duration, Instant};
+
+use tiny_http::{Header, Method, Request, Response, Server};
+
+use crate::error::Error;
+use crate::io::scene_file::MAX_PIXELS;
+use api::{Refusal, Studio};
+
+/// Arguments of `raystep serve`.
+#[derive(clap::Args, Debug)]
+pub struct ServeArgs {
+    /// Scene file (TOML) to serve; it is watched, and saving it re-renders the
+    /// page. Default: the built-in figure-1 scene (scenes/seed.toml).
+    pub scene: Option<PathBuf>,
+    /// The port to listen on, on 127.0.0.1 only (0: any free port; the address
+    /// printed says which).
+    #[arg(long, default_value_t = 8123)]
+    pub port: u16,
+    /// Open the page in the default browser once the server listens.
+    #[arg(long)]
+    pub open: bool,
+}
+
+/// Renders at once; more wait in line.
+pub const RENDERS_AT_ONCE: usize = 2;
+
+/// How long a render waits for its turn before the answer is 503.
+pub const QUEUE_WAIT: Duration = Duration::from_secs(30);
+
+/// Threads that answer requests (each render holds one while it runs).
+const WORKERS: usize = 8;
+
+/// Event streams (`/api/events`) open at once; more get 503.
+const MAX_STREAMS: usize = 32;
+
+/// How often the scene file is looked at.
+const WATCH_EVERY: Duration = Duration::from_millis(250);
+
+/// How often an idle event stream sends a comment, to notice a closed one.
+const KEEP_ALIVE: Duration = Duration::from_secs(15);
+
+const PAGE_HTML: &str = include_str!("../../../assets/studio/index.html");
+const PAGE_CSS: &str = include_str!("../../../assets/studio/studio.css");
+const PAGE_JS: &str = include_str!("../../../assets/studio/studio.js");
+
+/// The page's policy: its own files, its own API, nothing inline, no frames.
+const PAGE_POLICY: &str = "default-src 'none'; script-src 'self'; style-src 'self'; \
+     img-src 'self' blob: data:; connect-src 'self'; base-uri 'none'; form-action 'none'; \
+     frame-ancestors 'none'";
+
+/// Carry out `raystep serve`: listen, print the address, answer until Ctrl-C.
+pub fn run(args: &ServeArgs) -> Result<(), Error> {
+    let studio = Arc::new(Studio::open(args.scene.as_deref())?);
+    let address = SocketAddr::from(([127, 0, 0, 1], args.port));
+    let server = Server::http(address).map_err(|e| {
+        Error::Usage(format!(
+            "cannot listen on {address}: {e}; give another --port, or --port 0 for any free one"
+        ))
+    })?;
+    let port = server.server_addr().to_ip().map_or(args.port, |a| a.port());
+    let url = format!("http://127.0.0.1:{port}/");
+    {
+        let mut out = std::io::stdout().lock();
+        writeln!(out, "{url}")
+            .and_then(|()| out.flush())
+            .map_err(|e| Error::Output {
+                path: "standard output".into(),
+                message: e.to_string(),
+            })?;
+    }
+    eprintln!(
+        "serving {} on {url} (127.0.0.1 only); Ctrl-C to stop",
+        studio.name()
+    );
+    if args.open {
+        open_browser(&url);
+    }
+    let shared = Arc::new(Shared {
+        studio,
+        port,
+        gate: Gate::default(),
+        streams: Arc::new(AtomicUsize::new(0)),
+        stopping: AtomicBool::new(false),
+    });
+    let server = Arc::new(server);
+    let mut threads = Vec::new();
+    for _ in 0..WORKERS {
+        let (server, shared) = (Arc::clone(&server), Arc::clone(&shared));
+        threads.push(std::thread::spawn(move || {
+            while !shared.stopping.load(Ordering::Relaxed) {
+                match server.recv_timeout(Duration::from_millis(100)) {
+                    Ok(Some(request)) => answer(&shared, request),
+                    Ok(None) => {}
+                    Err(_) => break,
+                }
+            }
+        }));
+    }
+    let watcher = {
+        let shared = Arc::clone(&shared);
+        std::thread::spawn(move || {
+            while !shared.stopping.load(Ordering::Relaxed) {
+                std::thread::sleep(WATCH_EVERY);
+                shared.studio.poll();
+            }
+        })
+    };
+    while !crate::interrupt::requested() {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // Closing: no new requests, event streams told to end, answers under way
+    // finished (a render stops at its next row and answers 503).
+    shared.stopping.store(true, Ordering::Relaxed);
+    shared.studio.stop();
+    server.unblock();
+    for thread in threads {
+        let _ = thread.join();
+    }
+    let _ = watcher.join();
+    drop(server);
+    Err(Error::Interrupted)
+}
+
+/// Start the system's browser on `url`, or say how to open it by hand.
+fn open_browser(url: &str) {
+    let opener = if cfg!(target_os = "macos") {
+        "open"
+    } else {
+        "xdg-open"
+    };
+    let started = std::process::Command::new(opener)
+        .arg(url)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn();
+    if let Err(e) = started {
+        eprintln!("warning: cannot start a browser with {opener} ({e}); open {url} by hand");
+    }
+}
+
+/// What the threads share.
+struct Shared {
+    studio: Arc<Studio>,
+    port: u16,
+    gate: Gate,
+    streams: Arc<AtomicUsize>,
+    stopping: AtomicBool,
+}
+
+/// The renders in flight: how many, and their pixels.
+#[derive(Default)]
+struct Gate {
+    running: Mutex<(usize, u64)>,
+    freed: Condvar,
+}
+
+/// A render's place among those in flight, given back when dropped.
+struct Turn<'a> {
+    gate: &'a Gate,
+    pixels: u64,
+}
+
+impl Gate {
+    /// Wait for a turn to render `pixels`, until `deadline` or an interrupt.
+    fn enter(&self, pixels: u64, deadline: Instant) -> Option<Turn<'_>> {
+        let mut running = self.running.lock().unwrap_or_else(|e| e.into_inner());
+        loop {
+            let (count, busy) = *running;
+            // A render alone may always run: its size is within the limits.
+            if count == 0 || (count < RENDERS_AT_ONCE && busy + pixels <= MAX_PIXELS) {
+                *running = (count + 1, busy + pixels);
+                return Some(Turn { gate: self, pixels });
+            }
+            let now = Instant::now();
+            if now >= deadline || crate::interrupt::requested() {
+                return None;
+            }
+            let wait = (deadline - now).min(Duration::from_millis(100));
+            running = self
+                .freed
+                .wait_timeout(running, wait)
+                .unwrap_or_else(|e| e.into_inner())
+                .0;
+        }
+    }
+}
+
+impl Drop for Turn<'_> {
+    fn drop(&mut self) {
+        let mut running = self.gate.running.lock().unwrap_or_else(|e| e.into_inner());
+        running.0 -= 1;
+        running.1 -= self.pixels;
+        drop(running);
+        self.gate.freed.notify_all();
+    }
+}
+
+fn header(name: &str, value: &str) -> Header {
+    Header::from_bytes(name.as_bytes(), value.as_bytes()).expect("raystep's headers are ASCII")
+}
+
+/// Send `body` with `status`, as one block with its length (never chunked).
+fn send(request: Request, status: u16, kind: &str, body: Vec<u8>, extra: &[(&str, String)]) {
+    let mut response = Response::from_data(body)
+        .with_status_code(status)
+        .with_chunked_threshold(usize::MAX)
+        .with_header(header("Content-Type", kind))
+        .with_header(header("Cache-Control", "no-store"))
+        .with_header(header("X-Content-Type-Options", "nosniff"))
+        .with_header(header("Referrer-Policy", "no-referrer"));
+    for (name, value) in extra {
+        response.add_header(header(name, value));
+    }
+    // A client that went away is no concern of the server's.
+    let _ = request.respond(response);
+}
+
+const JSON: &str = "application/json; charset=utf-8";
+
+fn refuse(request: Request, refusal: &Refusal) {
+    send(
+        request,
+        refusal.status,
+        JSON,
+        refusal.json().into_bytes(),
+        &[],
+    );
+}
+
+fn error(request: Request, status: u16, message: &str) {
+    refuse(
+        request,
+        &Refusal {
+            status,
+            message: message.to_string(),
+        },
+    );
+}
+
+/// Whether `host` (a `Host` header) names this server: `127.0.0.1:PORT` or
+/// `localhost:PORT`.
+pub fn host_allowed(host: &str, port: u16) -> bool {
+    let host = host.to_ascii_lowercase();
+    host == format!("127.0.0.1:{port}") || host == format!("localhost:{port}")
+}
+
+/// Answer one request.
+fn answer(shared: &Shared, request: Request) {
+    let headers = |name: &'static str| -> Vec<String> {
+        request
+            .headers()
+            .iter()
+            .filter(|h| h.field.equiv(name))
+            .map(|h| h.value.as_str().to_string())
+            .collect()
+    };
+    let hosts = headers("Host");
+    if hosts.len() != 1 || !host_allowed(&hosts[0], shared.port) {
+        let port = shared.port;
+        return error(
+            request,
+            421,
+            &format!(
+                "this server answers only requests for 127.0.0.1:{port} or localhost:{port} \
+                 (the Host header)"
+            ),
+        );
+    }
+    if headers("Sec-Fetch-Site")
+        .iter()
+        .any(|site| !matches!(site.as_str(), "same-origin" | "none"))
+    {
+        return error(
+            request,
+            403,
+            "this server answers only its own page, not pages of other sites",
+        );
+    }
+    if !matches!(request.method(), Method::Get | Method::Head) {
+        let allow = [("Allow", "GET, HEAD".to_string())];
+        let body = Refusal {
+            status: 405,
+            message: "only GET (and HEAD) are answered".into(),
+        }
+        .json();
+        return send(request, 405, JSON, body.into_bytes(), &allow);
+    }
+    let url = request.url().to_string();
+    let (path, query) = url.split_once('?').unwrap_or((&url, ""));
+    let studio = &shared.studio;
+    match path {
+        "/" | "/index.html" => send(
+            request,
+            200,
+            "text/html; charset=utf-8",
+            PAGE_HTML.into(),
+            &[
+                ("Content-Security-Policy", PAGE_POLICY.to_string()),
+                ("X-Frame-Options", "DENY".to_string()),
+            ],
+        ),
+        "/studio.css" => send(
+            request,
+            200,
+            "text/css; charset=utf-8",
+            PAGE_CSS.into(),
+            &[],
+        ),
+        "/studio.js" => send(
+            request,
+            200,
+            "text/javascript; charset=utf-8",
+            PAGE_JS.into(),
+            &[],
+        ),
+        "/api/scene" => send(
+            request,
+            200,
+            JSON,
+            studio.scene_json().to_string().into_bytes(),
+            &[],
+        ),
+        "/api/pixel" => match studio.pixel(query) {
+            Ok(json) => send(request, 200, JSON, json.into_bytes(), &[]),
+            Err(refusal) => refuse(request, &refusal),
+        },
+        "/api/render" => render(shared, request, query),
+        "/api/events" => events(shared, request),
+        _ => error(
+            request,
+            404,
+            "no such page: the studio has /, /api/scene, /api/render, /api/pixel and /api/events",
+        ),
+    }
+}
+
+/// `GET /api/render`: the PNG, or why not.
+fn render(shared: &Shared, request: Request, query: &str) {
+    let job = match shared.studio.render_job(query) {
+        Ok(job) => job,
+        Err(refusal) => return refuse(request, &refusal),
+    };
+    let Some(turn) = shared.gate.enter(job.pixels(), Instant::now() + QUEUE_WAIT) else {
+        let retry = [("Retry-After", "1".to_string())];
+        let body = Refusal {
+            status: 503,
+            message: format!(
+                "busy: {RENDERS_AT_ONCE} renders at once, and this one waited {} s; try again",
+                QUEUE_WAIT.as_secs()
+            ),
+        }
+        .json();
+        return send(request, 503, JSON, body.into_bytes(), &retry);
+    };
+    let done = job.run();
+    drop(turn);
+    if crate::interrupt::requested() {
+        return error(request, 503, "the server is stopping");
+    }
+    let extra = [
+        (
+            "X-Raystep-Render-Seconds",
+            format!("{:.6}", done.render_seconds),
+        ),
+        (
+            "X-Raystep-Encode-Seconds",
+            format!("{:.6}", done.encode_seconds),
+        ),
+        ("X-Raystep-Scene-Version", job.version.to_string()),
+        (
+            "X-Raystep-Buffers",
+            api::buffers_of(job.settings.stages).join(","),
+        ),
+        (
+            "X-Raystep-Size",
+            format!("{}x{}", job.scene.width, job.scene.height),
+        ),
+    ];
+    send(request, 200, "image/png", done.png, &extra);
+}
+
+/// `GET /api/events`: server-sent events, one each time the scene file is
+/// reloaded, `data: {"version": N, "error": null or "..."}`, each on a thread of
+/// its own. The stream stays open until the client leaves or the server stops.
+///
+/// tiny_http's responses are buffered (chunks of 8 KiB), which would hold
+/// events back, so this answer is written straight to the connection: a
+/// status line and headers, then each event, flushed as it happens.
+fn events(shared: &Shared, request: Request) {
+    let streams = Arc::clone(&shared.streams);
+    if streams.fetch_add(1, Ordering::SeqCst) >= MAX_STREAMS {
+        streams.fetch_sub(1, Ordering::SeqCst);
+        return error(request, 503, "too many event streams are open");
+    }
+    let head_only = *request.method() == Method::Head;
+    let studio = Arc::clone(&shared.studio);
+    let mut writer = request.into_writer();
+    std::thread::spawn(move || {
+        let (version, _) = studio.version();
+        let head = "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\n\
+                    Cache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n\
+                    Connection: close\r\n\r\n";
+        let opened = writer
+            .write_all(head.as_bytes())
+            .and_then(|()| match head_only {
+                true => Ok(()),
+                false => write!(writer, "retry: 1000\n: connected at version {version}\n\n"),
+            })
+            .and_then(|()| writer.flush());
+        if opened.is_ok() && !head_only {
+            stream_events(&studio, writer, version);
+        }
+        streams.fetch_sub(1, Ordering::SeqCst);
+    });
+}
+
+/// Write an event for each new version until the server stops or the client
+/// goes away.
+fn stream_events(studio: &Studio, mut writer: Box<dyn Write + Send>, mut seen: u64) {
+    loop {
+        let (version, error, stopping) = studio.wait_change(seen, KEEP_ALIVE);
+        if stopping {
+            return;
+        }
+        let sent = if version == seen {
+            writer.write_all(b": still here\n\n")
+        } else {
+            seen = version;
+            let data = serde_json::json!({ "version": version, "error": error });
+            write!(writer, "data: {data}\n\n")
+        };
+        if sent.and_then(|()| writer.flush()).is_err() {
+            return;
+        }
+    }
+}

@@ -1,0 +1,1044 @@
+//! `raystep serve`, the studio: the built binary is started on a free port of
+//! 127.0.0.1 and spoken to over plain TCP (loopback only), as a browser or a
+//! script would. Each endpoint's answer is checked against the command line's
+//! own output for the same options; then its safety (the Host header, paths
+//! that try to leave the page, bad options), a load of 1,000 requests from 50
+//! clients, Ctrl-C, and a fuzz of the query parser (in-process).
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use proptest::prelude::*;
+use serde_json::Value;
+
+/// A `raystep serve` process, killed when dropped.
+struct Server {
+    child: Child,
+    port: u16,
+}
+
+impl Server {
+    /// Start `raystep serve [scene] --port 0` and read the address it prints.
+    fn start(scene: Option<&Path>) -> Server {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_raystep"));
+        command.arg("serve");
+        if let Some(scene) = scene {
+            command.arg(scene);
+        }
+        let mut child = command
+            .args(["--port", "0"])
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let stdout = child.stdout.take().unwrap();
+        let (sender, receiver) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let mut line = String::new();
+            let _ = BufReader::new(stdout).read_line(&mut line);
+            let _ = sender.send(line);
+        });
+        let line = receiver
+            .recv_timeout(Duration::from_secs(30))
+            .expect("raystep serve prints its address");
+        let port = line
+            .trim()
+            .strip_prefix("http://127.0.0.1:")
+            .and_then(|rest| rest.strip_suffix('/'))
+            .and_then(|port| port.parse().ok())
+            .unwrap_or_else(|| panic!("not an address: {line:?}"));
+        Server { child, port }
+    }
+
+    /// `GET target` with the right Host header.
+    fn get(&self, target: &str) -> Reply {
+        let host = format!("127.0.0.1:{}", self.port);
+        self.raw(&format!(
+            "GET {target} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n"
+        ))
+    }
+
+    /// Send `request` as it is and read the whole answer.
+    fn raw(&self, request: &str) -> Reply {
+        exchange(self.port, request)
+    }
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// An HTTP answer.
+#[derive(Debug)]
+struct Reply {
+    status: u16,
+    headers: Vec<(String, String)>,
+    body: Vec<u8>,
+}
+
+impl Reply {
+    fn header(&self, name: &str) -> Option<&str> {
+        self.headers
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(name))
+            .map(|(_, v)| v.as_str())
+    }
+
+    fn json(&self) -> Value {
+        serde_json::from_slice(&self.body).unwrap_or_else(|e| {
+            panic!("{e}: {}", String::from_utf8_lossy(&self.body));
+        })
+    }
+
+    /// The message of a refusal, `{"error": "..."}`.
+    fn error(&self) -> String {
+        self.json()["error"].as_str().unwrap().to_string()
+    }
+}
+
+/// Send `request` to 127.0.0.1:`port` and read the answer until the server
+/// closes the connection (every request here says `Connection: close`).
+fn exchange(port: u16, request: &str) -> Reply {
+    let mut stream = TcpStream::connect(("127.0.0.1", port)).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(60)))
+        .unwrap();
+    stream.write_all(request.as_bytes()).unwrap();
+    let mut bytes = Vec::new();
+    stream.read_to_end(&mut bytes).unwrap();
+    parse_reply(&bytes)
+}
+
+fn parse_reply(bytes: &[u8]) -> Reply {
+    let end = bytes
+        .windows(4)
+        .position(|w| w == b"\r\n\r\n")
+        .unwrap_or_else(|| panic!("no header end in {:?}", String::from_utf8_lossy(bytes)));
+    let head = std::str::from_utf8(&bytes[..end]).unwrap();
+    let mut lines = head.split("\r\n");
+    let status_line = lines.next().unwrap();
+    let status = status_line
+        .split(' ')
+        .nth(1)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("status line {status_line:?}"));
+    let headers: Vec<(String, String)> = lines
+        .filter_map(|l| l.split_once(':'))
+        .map(|(n, v)| (n.trim().to_string(), v.trim().to_string()))
+        .collect();
+    let body = bytes[end + 4..].to_vec();
+    let reply = Reply {
+        status,
+        headers,
+        body,
+    };
+    if let Some(length) = reply
+        .header("Content-Length")
+        .filter(|_| !reply.body.is_empty())
+    {
+        assert_eq!(length.parse::<usize>().unwrap(), reply.body.len(), "length");
+    }
+    reply
+}
+
+fn raystep(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_raystep"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// A folder with a copy of the built-in scene, as `scene.toml`.
+fn scene_folder() -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, raystep::io::scene_file::SEED_TOML).unwrap();
+    (dir, scene)
+}
+
+/// Query strings and the same options as command-line words.
+const CASES: [(&str, &[&str]); 6] = [
+    ("width=60&height=40", &["--width", "60", "--height", "40"]),
+    (
+        "stage=shadow&width=60&height=40&buffer=depth",
+        &["--stage", "shadow", "--width", "60", "--height", "40"],
+    ),
+    (
+        "without=blinn-phong&precision=f32&width=61&height=37&buffer=normal",
+        &[
+            "--without",
+            "blinn-phong",
+            "--precision",
+            "f32",
+            "--width",
+            "61",
+            "--height",
+            "37",
+        ],
+    ),
+    (
+        "stage=plane&without=shadow&without=reflection&width=50&height=30&buffer=object",
+        &[
+            "--stage",
+            "plane",
+            "--without",
+            "shadow",
+            "--without",
+            "reflection",
+            "--width",
+            "50",
+            "--height",
+            "30",
+        ],
+    ),
+    (
+        "tutorial&spp=4&width=40&height=30&buffer=rays",
+        &[
+            "--tutorial",
+            "--spp",
+            "4",
+            "--width",
+            "40",
+            "--height",
+            "30",
+        ],
+    ),
+    (
+        "engine=fast&offset=fixed%3A0&max-depth=5&width=64&height=40&buffer=bounces",
+        &[
+            "--engine",
+            "fast",
+            "--offset",
+            "fixed:0",
+            "--max-depth",
+            "5",
+            "--width",
+            "64",
+            "--height",
+            "40",
+        ],
+    ),
+];
+
+/// The buffer a case's query asks for.
+fn buffer_of(query: &str) -> &str {
+    query
+        .split('&')
+        .find_map(|p| p.strip_prefix("buffer="))
+        .unwrap_or("beauty")
+}
+
+#[test]
+fn render_answers_the_png_the_command_line_writes() {
+    let (dir, scene) = scene_folder();
+    let server = Server::start(Some(&scene));
+    for (i, (query, flags)) in CASES.iter().enumerate() {
+        let out = dir.path().join(format!("out{i}"));
+        let mut args = vec!["render", scene.to_str().unwrap()];
+        args.extend_from_slice(flags);
+        args.extend_from_slice(&["--out", out.to_str().unwrap()]);
+        let cli = raystep(&args);
+        assert!(
+            cli.status.success(),
+            "{}",
+            String::from_utf8_lossy(&cli.stderr)
+        );
+        let reply = server.get(&format!("/api/render?{query}"));
+        assert_eq!(
+            reply.status,
+            200,
+            "{query}: {}",
+            String::from_utf8_lossy(&reply.body)
+        );
+        assert_eq!(reply.header("Content-Type"), Some("image/png"));
+        let file = out.join(format!("{}.png", buffer_of(query)));
+        let expected = std::fs::read(&file).unwrap();
+        assert!(
+            reply.body == expected,
+            "{query}: the answer ({} bytes) is not {} ({} bytes)",
+            reply.body.len(),
+            file.display(),
+            expected.len()
+        );
+        assert_eq!(reply.header("X-Raystep-Scene-Version"), Some("1"));
+    }
+    // No options: the scene's own size, every stage, the beauty buffer.
+    let reply = server.get("/api/render");
+    assert_eq!(reply.status, 200);
+    assert_eq!(reply.header("X-Raystep-Size"), Some("300x200"));
+    assert_eq!(
+        reply.header("X-Raystep-Buffers"),
+        Some("beauty,direction,depth,normal,shadow,object,ambient,diffuse,specular,bounces,rays")
+    );
+}
+
+#[test]
+fn pixel_answers_what_explain_json_prints() {
+    let (_dir, scene) = scene_folder();
+    let server = Server::start(Some(&scene));
+    for (query, flags) in CASES {
+        for (x, y) in [(0, 0), (20, 17), (30, 25)] {
+            let mut args = vec!["explain", scene.to_str().unwrap()];
+            let pixel = format!("{x},{y}");
+            args.extend_from_slice(&["--pixel", &pixel, "--json"]);
+            args.extend_from_slice(flags);
+            let cli = raystep(&args);
+            assert!(
+                cli.status.success(),
+                "{}",
+                String::from_utf8_lossy(&cli.stderr)
+            );
+            let options: Vec<&str> = query
+                .split('&')
+                .filter(|p| !p.starts_with("buffer="))
+                .collect();
+            let reply = server.get(&format!("/api/pixel?x={x}&y={y}&{}", options.join("&")));
+            assert_eq!(
+                reply.status,
+                200,
+                "{query}: {}",
+                String::from_utf8_lossy(&reply.body)
+            );
+            assert_eq!(
+                String::from_utf8_lossy(&reply.body),
+                String::from_utf8_lossy(&cli.stdout),
+                "{query} at ({x}, {y})"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_scene_is_json_with_a_version_and_the_page_is_served() {
+    let server = Server::start(None);
+    let scene = server.get("/api/scene").json();
+    assert_eq!(scene["version"], 1);
+    assert_eq!(scene["error"], Value::Null);
+    assert_eq!(scene["file"], "scenes/seed.toml (built in)");
+    assert_eq!(scene["scene"]["width"], 300);
+    assert_eq!(scene["scene"]["objects"].as_array().unwrap().len(), 4);
+    assert_eq!(scene["scene"]["objects"][0]["shape"]["radius"], 0.7);
+    let page = server.get("/");
+    assert_eq!(page.status, 200);
+    assert!(String::from_utf8_lossy(&page.body).contains("raystep studio"));
+    assert!(page.header("Content-Security-Policy").is_some());
+    for (path, kind) in [
+        ("/studio.js", "text/javascript"),
+        ("/studio.css", "text/css"),
+    ] {
+        let reply = server.get(path);
+        assert_eq!(reply.status, 200, "{path}");
+        assert!(
+            reply.header("Content-Type").unwrap().starts_with(kind),
+            "{path}"
+        );
+    }
+    // HEAD: the headers alone; other methods are refused.
+    let host = format!("127.0.0.1:{}", server.port);
+    let head = server.raw(&format!(
+        "HEAD /api/scene HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n"
+    ));
+    assert_eq!(head.status, 200);
+    assert!(head.body.is_empty());
+    let post = server.raw(&format!(
+        "POST /api/scene HTTP/1.1\r\nHost: {host}\r\nContent-Length: 0\r\nConnection: close\r\n\r\n"
+    ));
+    assert_eq!(post.status, 405);
+}
+
+/// The command line's message for `args`, as it prints it on stderr (without
+/// `error: `), and its exit code, which must be 2.
+fn cli_error(args: &[&str]) -> String {
+    let out = raystep(args);
+    assert_eq!(out.status.code(), Some(2), "{args:?}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let text = stderr.trim_end();
+    text.strip_prefix("error: ").unwrap_or(text).to_string()
+}
+
+#[test]
+fn a_bad_option_is_400_with_the_command_lines_message_and_the_server_keeps_serving() {
+    let (dir, scene) = scene_folder();
+    let server = Server::start(Some(&scene));
+    let s = scene.to_str().unwrap();
+    let out = dir.path().join("never");
+    let o = out.to_str().unwrap();
+    let cases: [(&str, Vec<&str>); 8] = [
+        // clap's messages show the usage of what was given: no scene file here.
+        (
+            "precision=f16",
+            vec!["render", "--precision", "f16", "--out", o],
+        ),
+        ("stage=nope", vec!["render", "--stage", "nope", "--out", o]),
+        (
+            "stage=shadow&without=plane",
+            vec![
+                "render",
+                s,
+                "--stage",
+                "shadow",
+                "--without",
+                "plane",
+                "--out",
+                o,
+            ],
+        ),
+        (
+            "without=intersection",
+            vec!["render", s, "--without", "intersection", "--out", o],
+        ),
+        ("width=0", vec!["render", s, "--width", "0", "--out", o]),
+        (
+            "width=9000&height=9000",
+            vec![
+                "render", s, "--width", "9000", "--height", "9000", "--out", o,
+            ],
+        ),
+        ("spp=3", vec!["render", s, "--spp", "3", "--out", o]),
+        ("pixel=1,2", vec!["render", "--pixel", "1,2", "--out", o]),
+    ];
+    for (query, args) in cases {
+        let reply = server.get(&format!("/api/render?{query}"));
+        assert_eq!(reply.status, 400, "{query}");
+        assert_eq!(reply.error(), cli_error(&args), "{query}");
+        assert_eq!(
+            server.get("/api/scene").status,
+            200,
+            "still up after {query}"
+        );
+    }
+    // explain's own refusals.
+    let explain = [
+        (
+            "x=300&y=0",
+            vec!["explain", s, "--pixel", "300,0", "--json"],
+        ),
+        ("x=a&y=1", vec!["explain", "--pixel", "a,1", "--json"]),
+        (
+            "x=1&y=2&buffer=beauty",
+            vec!["explain", "--pixel", "1,2", "--json", "--buffer", "beauty"],
+        ),
+    ];
+    for (query, args) in explain {
+        let reply = server.get(&format!("/api/pixel?{query}"));
+        assert_eq!(reply.status, 400, "{query}");
+        assert_eq!(reply.error(), cli_error(&args), "{query}");
+    }
+    // The API's own refusals.
+    for (path, words) in [
+        (
+            "/api/render?stage=rays&buffer=depth",
+            "a render of rays has no depth buffer",
+        ),
+        ("/api/render?buffer=colour", "buffer=colour: no such buffer"),
+        (
+            "/api/render?out=%2Ftmp%2Fx",
+            "`out` is not an option of the API",
+        ),
+        ("/api/render?Stage=plane", "`Stage` is not an option"),
+        ("/api/render?--stage=plane", "is not an option"),
+        ("/api/pixel?x=1", "give the pixel as x=X&y=Y"),
+        (
+            "/api/render?buffer=depth&buffer=beauty",
+            "`buffer` is given more than once",
+        ),
+    ] {
+        let reply = server.get(path);
+        assert_eq!(reply.status, 400, "{path}");
+        assert!(reply.error().contains(words), "{path}: {}", reply.error());
+    }
+    assert!(!out.exists(), "nothing is written");
+}
+
+#[test]
+fn a_request_for_another_host_is_421() {
+    let server = Server::start(None);
+    let port = server.port;
+    for host in [
+        format!("evil.example:{port}"),
+        format!("127.0.0.1:{}", port.wrapping_add(1)),
+        "127.0.0.1".to_string(),
+        format!("localhost.evil.example:{port}"),
+        format!("[::1]:{port}"),
+    ] {
+        let reply = server.raw(&format!(
+            "GET /api/scene HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n"
+        ));
+        assert_eq!(reply.status, 421, "{host}");
+        assert!(reply.error().contains("Host"), "{host}");
+    }
+    // No Host at all, and two of them.
+    let none = server.raw("GET /api/scene HTTP/1.0\r\n\r\n");
+    assert_eq!(none.status, 421);
+    let two = server.raw(&format!(
+        "GET /api/scene HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nHost: evil.example\r\nConnection: close\r\n\r\n"
+    ));
+    assert_eq!(two.status, 421);
+    // localhost is this server too; a request another site's page makes is not.
+    let local = server.raw(&format!(
+        "GET /api/scene HTTP/1.1\r\nHost: LocalHost:{port}\r\nConnection: close\r\n\r\n"
+    ));
+    assert_eq!(local.status, 200);
+    let cross = server.raw(&format!(
+        "GET /api/render?width=8&height=8 HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nSec-Fetch-Site: cross-site\r\nConnection: close\r\n\r\n"
+    ));
+    assert_eq!(cross.status, 403);
+}
+
+#[test]
+fn paths_that_leave_the_page_are_404() {
+    let server = Server::start(None);
+    for target in [
+        "/../Cargo.toml",
+        "/%2e%2e/",
+        "/%2e%2e/Cargo.toml",
+        "/%2E%2E%2FCargo.toml",
+        "/..%2fCargo.toml",
+        "//etc/passwd",
+        "/etc/passwd",
+        "/api/../Cargo.toml",
+        "/studio.js/../../Cargo.toml",
+        "/assets/studio/studio.js",
+        "/src/main.rs",
+        "/api/render/../../Cargo.toml",
+        "/%00",
+        "http://127.0.0.1/../Cargo.toml",
+    ] {
+        let reply = server.get(target);
+        assert_eq!(reply.status, 404, "{target}");
+        let body = String::from_utf8_lossy(&reply.body);
+        assert!(
+            !body.contains("[package]") && !body.contains("root:"),
+            "{target}: {body}"
+        );
+    }
+}
+
+/// Read from `stream` into `seen` until it holds `needle` after `from`, or fail
+/// after `timeout`.
+fn read_until(
+    stream: &mut TcpStream,
+    seen: &mut Vec<u8>,
+    from: usize,
+    needle: &str,
+    timeout: Duration,
+) {
+    let deadline = Instant::now() + timeout;
+    let found =
+        |seen: &[u8]| String::from_utf8_lossy(&seen[from.min(seen.len())..]).contains(needle);
+    while !found(seen) {
+        assert!(
+            Instant::now() < deadline,
+            "no {needle:?} in {:?}",
+            String::from_utf8_lossy(seen)
+        );
+        let mut chunk = [0; 4096];
+        match stream.read(&mut chunk) {
+            Ok(0) => panic!("the stream closed: {:?}", String::from_utf8_lossy(seen)),
+            Ok(n) => seen.extend_from_slice(&chunk[..n]),
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) => {}
+            Err(e) => panic!("{e}"),
+        }
+    }
+}
+
+#[test]
+fn saving_the_scene_reloads_it_with_an_event_and_a_broken_file_keeps_the_last_good_scene() {
+    let (_dir, scene) = scene_folder();
+    let server = Server::start(Some(&scene));
+    let mut events = TcpStream::connect(("127.0.0.1", server.port)).unwrap();
+    events
+        .set_read_timeout(Some(Duration::from_millis(200)))
+        .unwrap();
+    write!(
+        events,
+        "GET /api/events HTTP/1.1\r\nHost: 127.0.0.1:{}\r\n\r\n",
+        server.port
+    )
+    .unwrap();
+    let mut seen = Vec::new();
+    let wait = Duration::from_secs(10);
+    read_until(
+        &mut events,
+        &mut seen,
+        0,
+        ": connected at version 1\n\n",
+        wait,
+    );
+    let head = String::from_utf8_lossy(&seen).to_string();
+    assert!(head.starts_with("HTTP/1.1 200 OK\r\n"), "{head}");
+    assert!(
+        head.contains("Content-Type: text/event-stream\r\n"),
+        "{head}"
+    );
+    let before = server.get("/api/render?width=60&height=40").body;
+
+    // A change: an event within a second, a new version, a new picture.
+    let text = raystep::io::scene_file::SEED_TOML;
+    assert!(text.contains("radius = 0.7"));
+    let saved = Instant::now();
+    std::fs::write(&scene, text.replace("radius = 0.7", "radius = 0.5")).unwrap();
+    let mark = seen.len();
+    read_until(
+        &mut events,
+        &mut seen,
+        mark,
+        "data: {\"error\":null,\"version\":2}\n\n",
+        wait,
+    );
+    assert!(
+        saved.elapsed() < Duration::from_secs(2),
+        "{:?}",
+        saved.elapsed()
+    );
+    let json = server.get("/api/scene").json();
+    assert_eq!(json["version"], 2);
+    assert_eq!(json["scene"]["objects"][0]["shape"]["radius"], 0.5);
+    let after = server.get("/api/render?width=60&height=40");
+    assert_eq!(after.header("X-Raystep-Scene-Version"), Some("2"));
+    assert_ne!(after.body, before, "the picture follows the file");
+
+    // A broken file: the event and /api/scene carry the command line's message,
+    // and the last good scene is still rendered.
+    let broken = text.replace("radius = 0.7", "radius = -1");
+    std::fs::write(&scene, &broken).unwrap();
+    let cli = cli_error(&["check", scene.to_str().unwrap()]);
+    let mark = seen.len();
+    read_until(&mut events, &mut seen, mark, "\"version\":3}\n\n", wait);
+    let event = String::from_utf8_lossy(&seen[mark..]).to_string();
+    let data: Value = serde_json::from_str(
+        event
+            .lines()
+            .find_map(|l| l.strip_prefix("data: "))
+            .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(data["error"], cli.as_str());
+    let json = server.get("/api/scene").json();
+    assert_eq!(json["version"], 3);
+    assert_eq!(json["error"], cli.as_str());
+    assert_eq!(json["scene"]["objects"][0]["shape"]["radius"], 0.5);
+    assert_eq!(
+        server.get("/api/render?width=60&height=40").body,
+        after.body
+    );
+
+    // Mended: version 4, no error.
+    std::fs::write(&scene, text).unwrap();
+    let mark = seen.len();
+    read_until(
+        &mut events,
+        &mut seen,
+        mark,
+        "data: {\"error\":null,\"version\":4}\n\n",
+        wait,
+    );
+    assert_eq!(server.get("/api/render?width=60&height=40").body, before);
+}
+
+#[test]
+fn load_of_1000_requests_from_50_clients_is_answered_and_the_server_stays_up() {
+    const CLIENTS: usize = 50;
+    const EACH: usize = 20;
+    let server = Server::start(None);
+    let port = server.port;
+    let started = Instant::now();
+    let threads: Vec<_> = (0..CLIENTS)
+        .map(|client| {
+            std::thread::spawn(move || {
+                let mut latencies = Vec::new();
+                for i in 0..EACH {
+                    let n = client * EACH + i;
+                    let host = format!("127.0.0.1:{port}");
+                    let get = |target: &str| {
+                        format!("GET {target} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n")
+                    };
+                    let stages = ["rays", "intersection", "shadow", "blinn-phong", "reflection", "plane"];
+                    let (request, expected): (String, &[u16]) = match n % 10 {
+                        0..=3 => (
+                            get(&format!("/api/render?stage={}&width=60&height=40", stages[n % 6])),
+                            &[200],
+                        ),
+                        4 => (get(&format!("/api/pixel?x={}&y={}&width=60&height=40", n % 60, n % 40)), &[200]),
+                        5 => (get("/api/scene"), &[200]),
+                        6 => (get(&format!("/api/render?precision=f{n}&width=60&height=40")), &[400]),
+                        7 => (
+                            format!("GET /api/scene HTTP/1.1\r\nHost: evil.example:{port}\r\nConnection: close\r\n\r\n"),
+                            &[421],
+                        ),
+                        8 => (get("/%2e%2e/%2e%2e/etc/passwd"), &[404]),
+                        // Not HTTP at all: tiny_http answers 400 and closes.
+                        _ => ("NONSENSE\r\n\r\n".to_string(), &[400]),
+                    };
+                    let start = Instant::now();
+                    let reply = exchange(port, &request);
+                    latencies.push(start.elapsed());
+                    assert!(
+                        expected.contains(&reply.status),
+                        "request {n}: {} for {request:?}",
+                        reply.status
+                    );
+                }
+                latencies
+            })
+        })
+        .collect();
+    let mut latencies = Vec::new();
+    for thread in threads {
+        latencies.extend(thread.join().expect("every request is answered"));
+    }
+    let seconds = started.elapsed().as_secs_f64();
+    assert_eq!(latencies.len(), CLIENTS * EACH);
+    latencies.sort();
+    eprintln!(
+        "load: {} requests from {CLIENTS} clients in {seconds:.2} s: {:.0} requests/s, \
+         median {:?}, max {:?}",
+        latencies.len(),
+        latencies.len() as f64 / seconds,
+        latencies[latencies.len() / 2],
+        latencies.last().unwrap()
+    );
+    // Still up, and still right.
+    let scene = server.get("/api/scene");
+    assert_eq!(scene.status, 200);
+    assert_eq!(server.get("/api/render?width=60&height=40").status, 200);
+}
+
+#[test]
+fn ctrl_c_stops_the_server_with_exit_code_130() {
+    let mut server = Server::start(None);
+    assert_eq!(server.get("/api/scene").status, 200);
+    let pid = server.child.id().to_string();
+    let kill = Command::new("kill").args(["-INT", &pid]).status().unwrap();
+    assert!(kill.success());
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let status = loop {
+        if let Some(status) = server.child.try_wait().unwrap() {
+            break status;
+        }
+        assert!(Instant::now() < deadline, "still running after Ctrl-C");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(status.code(), Some(130));
+    assert!(
+        TcpStream::connect(("127.0.0.1", server.port)).is_err(),
+        "closed"
+    );
+}
+
+#[test]
+fn the_host_header_is_checked_exactly() {
+    use raystep::tools::serve::host_allowed;
+    assert!(host_allowed("127.0.0.1:8123", 8123));
+    assert!(host_allowed("localhost:8123", 8123));
+    assert!(host_allowed("LOCALHOST:8123", 8123));
+    for host in [
+        "127.0.0.1",
+        "localhost",
+        "127.0.0.1:81230",
+        "127.0.0.1:8123.evil",
+        "evil:8123",
+        " 127.0.0.1:8123",
+    ] {
+        assert!(!host_allowed(host, 8123), "{host}");
+    }
+}
+
+/// Keys of the query: the flags, a few others, and anything.
+fn key() -> impl Strategy<Value = String> {
+    prop_oneof![
+        prop::sample::select(vec![
+            "stage",
+            "without",
+            "width",
+            "height",
+            "precision",
+            "intersect",
+            "offset",
+            "viewer",
+            "max-depth",
+            "spp",
+            "early-stop",
+            "accel",
+            "engine",
+            "avx",
+            "tutorial",
+            "buffer",
+            "x",
+            "y",
+            "pixel",
+            "json",
+            "out",
+            "help",
+            "version",
+            "scene",
+            "",
+        ])
+        .prop_map(String::from),
+        "[a-zA-Z0-9%+=._-]{0,12}",
+        any::<String>(),
+    ]
+}
+
+/// Values: the valid ones, numbers near the limits, and anything.
+fn value() -> impl Strategy<Value = String> {
+    prop_oneof![
+        prop::sample::select(vec![
+            "",
+            "plane",
+            "shadow",
+            "rays",
+            "f32",
+            "f64",
+            "naive",
+            "stable",
+            "auto",
+            "fixed:0",
+            "fixed:1e-5",
+            "fixed:-1",
+            "fixed:nan",
+            "on",
+            "off",
+            "book",
+            "fast",
+            "bvh",
+            "beauty",
+            "depth",
+            "bounces",
+            "4",
+            "16",
+            "1024",
+            "1025",
+            "0",
+            "-1",
+            "64",
+            "65",
+            "16384",
+            "16385",
+            "4294967296",
+            "1e3",
+            "%",
+            "%zz",
+            "%2e%2e",
+            "..",
+            "/etc/passwd",
+        ])
+        .prop_map(String::from),
+        (0u32..100).prop_map(|n| n.to_string()),
+        any::<String>(),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+    /// Any query: an answer (200) or a refusal with a message (400), never a panic.
+    #[test]
+    fn any_query_is_answered_or_refused_with_a_message(
+        pairs in prop::collection::vec((key(), value()), 0..8),
+        raw in any::<bool>(),
+    ) {
+        static STUDIO: std::sync::OnceLock<raystep::tools::serve::api::Studio> = std::sync::OnceLock::new();
+        let studio = STUDIO.get_or_init(|| raystep::tools::serve::api::Studio::open(None).unwrap());
+        // Encoded as a browser would, or sent as it is (stray `%`, `&` and `=`).
+        let query = if raw {
+            pairs.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join("&")
+        } else {
+            encode(&pairs)
+        };
+        match studio.render_job(&query) {
+            Ok(job) => {
+                // Within the command line's limits.
+                prop_assert!(job.pixels() <= raystep::io::scene_file::MAX_PIXELS);
+                prop_assert!(job.settings.spp <= raystep::io::scene_file::MAX_SPP);
+            }
+            Err(refusal) => {
+                prop_assert_eq!(refusal.status, 400);
+                prop_assert!(!refusal.message.is_empty());
+            }
+        }
+        match studio.pixel(&format!("x=1&y=1&{query}")) {
+            Ok(json) => {
+                let story: Value = serde_json::from_str(&json).unwrap();
+                prop_assert_eq!(&story["x"], 1);
+            }
+            Err(refusal) => {
+                prop_assert_eq!(refusal.status, 400);
+                prop_assert!(!refusal.message.is_empty());
+            }
+        }
+    }
+}
+
+/// `application/x-www-form-urlencoded`, as URLSearchParams writes it.
+fn encode(pairs: &[(String, String)]) -> String {
+    let escape = |s: &str| {
+        s.bytes()
+            .map(|b| match b {
+                b'a'..=b'z' | b'A'..=b'Z' | b'0'..=b'9' | b'-' | b'.' | b'_' | b'*' => {
+                    char::from(b).to_string()
+                }
+                b' ' => "+".to_string(),
+                _ => format!("%{b:02X}"),
+            })
+            .collect::<String>()
+    };
+    pairs
+        .iter()
+        .map(|(k, v)| format!("{}={}", escape(k), escape(v)))
+        .collect::<Vec<_>>()
+        .join("&")
+}
+
+/// Chromium and Node.js with playwright-core, or what is missing (as
+/// tests/page.rs finds them).
+fn browser_tools() -> Result<PathBuf, String> {
+    let chromium = std::env::var_os("CHROMIUM")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
+    let mut missing = Vec::new();
+    if !chromium.is_file() {
+        missing.push(format!("Chromium at {}", chromium.display()));
+    }
+    let node = Command::new("node").arg("--version").output();
+    if !node.is_ok_and(|o| o.status.success()) {
+        missing.push("Node.js".to_string());
+    }
+    let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    if !manifest
+        .join("tests/browser/node_modules/playwright-core")
+        .is_dir()
+    {
+        missing.push("playwright-core (npm ci --prefix tests/browser)".to_string());
+    }
+    if missing.is_empty() {
+        Ok(chromium)
+    } else {
+        Err(missing.join("; "))
+    }
+}
+
+/// The page in a real headless Chromium (`tests/browser/studio.mjs`): stages
+/// switched, a refusal shown with the command line's reason, a buffer picked, a
+/// pixel's story read (exactly `explain --json`), and a saved scene followed.
+#[test]
+fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_file() {
+    let chromium = match browser_tools() {
+        Ok(chromium) => chromium,
+        Err(missing) if std::env::var_os("CI").is_some() => {
+            panic!("the browser test needs: {missing}")
+        }
+        Err(missing) => {
+            eprintln!("skipped: the browser test needs: {missing}");
+            return;
+        }
+    };
+    let (dir, scene) = scene_folder();
+    let new_scene = dir.path().join("new.toml");
+    let text = raystep::io::scene_file::SEED_TOML;
+    std::fs::write(&new_scene, text.replace("radius = 0.7", "radius = 0.5")).unwrap();
+    let server = Server::start(Some(&scene));
+    const VIEWPORT: (u32, u32) = (1400, 1000);
+    let (x, y) = (150, 120);
+    let screenshot = dir.path().join("studio.png");
+    // The story the page must tell, before the page changes the scene file.
+    let pixel = format!("{x},{y}");
+    let explain = Command::new(env!("CARGO_BIN_EXE_raystep"))
+        .arg("explain")
+        .arg(&scene)
+        .args(["--pixel", &pixel, "--json", "--stage", "plane"])
+        .output()
+        .unwrap();
+    let run = Command::new("node")
+        .arg(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/browser/studio.mjs"))
+        .arg("--url")
+        .arg(format!("http://127.0.0.1:{}/", server.port))
+        .arg("--screenshot")
+        .arg(&screenshot)
+        .arg("--scene")
+        .arg(&scene)
+        .arg("--new-scene")
+        .arg(&new_scene)
+        .arg("--chromium")
+        .arg(&chromium)
+        .arg("--size")
+        .arg(format!("{}x{}", VIEWPORT.0, VIEWPORT.1))
+        .arg("--pixel")
+        .arg(format!("{x},{y}"))
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "studio.mjs failed:\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let report: Value = serde_json::from_slice(&run.stdout)
+        .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&run.stdout)));
+    for key in ["pageErrors", "failedRequests"] {
+        assert_eq!(report[key], serde_json::json!([]), "{key}");
+    }
+    // The one message in the console: Chromium's note of the refused render.
+    let refused_load = "Failed to load resource: the server responded with a status of 400 \
+                        (Bad Request)";
+    assert_eq!(
+        report["console"],
+        serde_json::json!([{"type": "error", "text": refused_load}])
+    );
+    let queries: Vec<(&str, &str)> = report["steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| {
+            (
+                s["action"].as_str().unwrap(),
+                s["query"].as_str().unwrap_or(""),
+            )
+        })
+        .collect();
+    assert_eq!(
+        queries,
+        [
+            ("load", "stage=plane&buffer=beauty"),
+            ("shadow off", "stage=plane&without=shadow&buffer=beauty"),
+            ("shadow on", "stage=plane&buffer=beauty"),
+            // Refused: the picture and its query stay those of the last render.
+            ("rays off", "stage=plane&buffer=beauty"),
+            ("rays on", "stage=plane&buffer=beauty"),
+            ("depth", "stage=plane&buffer=depth"),
+            ("scene saved", "stage=plane&buffer=depth"),
+        ]
+    );
+    // The refusal is the command line's.
+    let s = scene.to_str().unwrap();
+    let refused = cli_error(&["render", s, "--stage", "plane", "--without", "rays"]);
+    assert_eq!(report["refusal"], refused.as_str());
+    // The story is exactly `explain --json`, of the scene as it was then.
+    let story = report["story"]["json"].as_str().unwrap();
+    assert!(story == String::from_utf8_lossy(&explain.stdout), "{story}");
+    assert!(report["storyText"].as_str().unwrap().contains("Segment 0"));
+    assert_eq!(report["version"], "2");
+
+    // The screenshot: a PNG of the window's size, not one flat colour; a copy
+    // stays in target/ for a person to look at.
+    let bytes = std::fs::read(&screenshot).unwrap();
+    let picture = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+        .unwrap()
+        .to_rgb8();
+    assert_eq!(picture.dimensions(), VIEWPORT);
+    let colours: std::collections::HashSet<[u8; 3]> = picture.pixels().map(|p| p.0).collect();
+    assert!(colours.len() > 100, "{} colours", colours.len());
+    let keep = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target");
+    std::fs::create_dir_all(&keep).unwrap();
+    std::fs::copy(&screenshot, keep.join("studio-screenshot.png")).unwrap();
+}
