@@ -279,6 +279,7 @@ impl<T: Real> Tracer<T> {
     // ANCHOR_END: pixel
 
     // ANCHOR: trace
+    // ANCHOR: trace_start
     /// Follow a ray through the scene, as the tutorial's final program does,
     /// telling `look` what happens on the way.
     #[inline(always)]
@@ -306,6 +307,7 @@ impl<T: Real> Tracer<T> {
             let shifted = shadow::step_off(point, normal, object, self.offset);
             let to_light = (self.light.position - shifted).normalize();
             look.hit(&hit, point, normal, shifted);
+            // ANCHOR_END: trace_start
 
             // ANCHOR: shadow_test
             // Shadow: a point that does not see the light ends the path, black.
@@ -331,6 +333,7 @@ impl<T: Real> Tracer<T> {
                 terms
             });
             // ANCHOR_END: shading
+            // ANCHOR: trace_end
             if segment == 0 {
                 first = Some(FirstHit {
                     depth: hit.t.to_f64(),
@@ -373,6 +376,7 @@ impl<T: Real> Tracer<T> {
         }
         // ANCHOR_END: accumulate
     }
+    // ANCHOR_END: trace_end
     // ANCHOR_END: trace
 }
 

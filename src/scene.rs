@@ -138,7 +138,7 @@ pub struct Hit<T: Real = f64> {
     pub object: usize,
 }
 
-// ANCHOR: nearest_hit
+// ANCHOR: object_intersect
 impl<T: Real> Object<T> {
     /// Distance along `ray` to this object, if it is hit (spheres by `method`).
     #[inline(always)]
@@ -159,6 +159,9 @@ impl<T: Real> Object<T> {
     }
 }
 
+// ANCHOR_END: object_intersect
+
+// ANCHOR: nearest_hit
 /// The first object along `ray`: test them all, keep the smallest distance.
 #[inline(always)]
 pub fn nearest_hit<T: Real>(objects: &[Object<T>], ray: &Ray<T>, method: Method) -> Option<Hit<T>> {

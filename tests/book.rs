@@ -55,16 +55,67 @@ fn includes(text: &str) -> Vec<(String, Option<String>)> {
 /// The appendix that states the tutorial's rules, listed after the chapters.
 const APPENDIX: &str = "tutorial-rules.md";
 
+/// The numbered chapters.
+const CHAPTERS: usize = 12;
+
+/// Everything SUMMARY.md lists after the numbered chapters, in order: suffix
+/// chapters that show no code of their own.
+const APPENDICES: &[&str] = &[APPENDIX, ANSWERS, "notes/speed-log.md"];
+
+/// The appendix that answers the exercises, a section for each chapter that has
+/// some.
+const ANSWERS: &str = "answers.md";
+
+/// The top-level items (`1. `, `2. `, …) of the numbered lists in `section`.
+fn numbered_items(section: &str) -> usize {
+    let item = |l: &&str| {
+        let digits = l.len() - l.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+        digits > 0 && l[digits..].starts_with(". ")
+    };
+    section.lines().filter(item).count()
+}
+
 #[test]
-fn every_chapter_file_is_in_the_summary_and_there_are_eleven_chapters() {
+fn the_answers_appendix_answers_every_exercise_of_every_chapter() {
+    let answers = chapters()
+        .into_iter()
+        .find(|(name, _)| name == ANSWERS)
+        .expect("SUMMARY.md lists the answers")
+        .1;
+    // The appendix's sections, each from its `## ` heading to the next.
+    let sections: Vec<&str> = answers.split("\n## ").skip(1).collect();
+    let mut answered = 0;
+    for (name, text) in chapters() {
+        let Some((_, exercises)) = text.split_once("\n## Exercises\n") else {
+            continue;
+        };
+        let exercises = numbered_items(exercises.split("\n## ").next().unwrap());
+        // A section that links to the chapter's exercises, an answer for each.
+        let link = format!("]({name}#exercises)");
+        let section = sections
+            .iter()
+            .find(|s| s.contains(&link))
+            .unwrap_or_else(|| panic!("{ANSWERS} has no section linking {link}"));
+        assert_eq!(
+            numbered_items(section),
+            exercises,
+            "{ANSWERS} should answer each of the {exercises} exercises of {name}"
+        );
+        answered += 1;
+    }
+    assert!(answered >= 9, "{answered} chapters with exercises");
+}
+
+#[test]
+fn every_chapter_file_is_in_the_summary_and_there_are_twelve_chapters() {
     let listed: Vec<String> = chapters().into_iter().map(|(n, _)| n).collect();
     assert_eq!(
         listed.len(),
-        13,
-        "the introduction, eleven chapters and the appendix: {listed:?}"
+        1 + CHAPTERS + APPENDICES.len(),
+        "the introduction, {CHAPTERS} chapters and the appendices: {listed:?}"
     );
     assert_eq!(listed[0], "introduction.md", "{listed:?}");
-    for (i, name) in listed[1..12].iter().enumerate() {
+    for (i, name) in listed[1..=CHAPTERS].iter().enumerate() {
         assert!(
             name.starts_with(&format!("{:02}-", i + 1)),
             "chapter {} should be numbered {:02}: {listed:?}",
@@ -72,22 +123,40 @@ fn every_chapter_file_is_in_the_summary_and_there_are_eleven_chapters() {
             i + 1
         );
     }
-    assert_eq!(listed[12], APPENDIX, "the appendix comes last: {listed:?}");
-    // A suffix chapter: a plain link after the numbered list, not an item of it.
+    assert_eq!(
+        listed[1 + CHAPTERS..],
+        *APPENDICES,
+        "the appendices come last: {listed:?}"
+    );
+    // Suffix chapters: plain links after the numbered list, not items of it.
     let summary = std::fs::read_to_string(root().join("chapters/SUMMARY.md")).unwrap();
     let lines: Vec<&str> = summary.lines().collect();
-    let at = lines
+    let first = lines
         .iter()
         .position(|l| l.contains(&format!("]({APPENDIX})")))
         .unwrap();
     assert!(
-        lines[at].starts_with('[') && at > 0 && lines[at - 1].trim().is_empty(),
+        first > 0 && lines[first - 1].trim().is_empty(),
         "SUMMARY.md should list {APPENDIX} as a suffix chapter, after a blank line"
     );
-    for entry in std::fs::read_dir(root().join("chapters")).unwrap() {
-        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
-        if name.ends_with(".md") && name != "SUMMARY.md" {
-            assert!(listed.contains(&name), "{name} is not in SUMMARY.md");
+    for appendix in APPENDICES {
+        let line = lines.iter().find(|l| l.contains(&format!("]({appendix})")));
+        assert!(
+            line.is_some_and(|l| l.starts_with('[')),
+            "SUMMARY.md should list {appendix} as a suffix chapter"
+        );
+    }
+    for dir in ["", "notes"] {
+        for entry in std::fs::read_dir(root().join("chapters").join(dir)).unwrap() {
+            let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+            let name = if dir.is_empty() {
+                name
+            } else {
+                format!("{dir}/{name}")
+            };
+            if name.ends_with(".md") && name != "SUMMARY.md" {
+                assert!(listed.contains(&name), "{name} is not in SUMMARY.md");
+            }
         }
     }
 }
@@ -100,7 +169,7 @@ fn every_include_names_a_file_and_anchor_with_text() {
             .filter(|(p, _)| p.starts_with("../src/"))
             .count();
         assert!(
-            name == "introduction.md" || name == APPENDIX || from_src > 0,
+            name == "introduction.md" || APPENDICES.contains(&name.as_str()) || from_src > 0,
             "{name} shows no code from src/"
         );
         for (path, anchor) in includes(&text) {
@@ -158,10 +227,13 @@ fn rust_blocks_are_included_from_the_compiled_source() {
             } else if fence && in_rust {
                 in_rust = false;
             } else if in_rust {
+                // From src/, or from a test's Rust file, which `cargo test` builds.
+                let compiled = line.contains("{{#include ../src/")
+                    || (line.contains("{{#include ../tests/") && line.contains(".rs:"));
                 assert!(
-                    line.trim().is_empty() || line.contains("{{#include ../src/"),
+                    line.trim().is_empty() || compiled,
                     "{name}: a Rust block holds code that is not included from src/ \
-                     (include it, or mark the block `ignore`): {line}"
+                     or tests/ (include it, or mark the block `ignore`): {line}"
                 );
             }
         }
@@ -465,6 +537,87 @@ fn the_charts_shown_exist_and_their_numbers_are_the_csv_files() {
     assert_eq!(rmse("early stop off"), rmse("default"));
 }
 
+/// A column of `chapters/charts/chart.csv` for one setting: 1 the median time in
+/// ms, 2 the error in 8-bit levels.
+fn chart_value(setting: &str, column: usize) -> f64 {
+    let csv = std::fs::read_to_string(root().join("chapters/charts/chart.csv")).unwrap();
+    let row = csv
+        .lines()
+        .find(|l| l.starts_with(&format!("{setting},")))
+        .unwrap_or_else(|| panic!("chart.csv has no row {setting}"));
+    row.split(',').nth(column).unwrap().parse().unwrap()
+}
+
+#[test]
+fn chapter_10_quotes_the_charts_csv_files() {
+    let text = chapter("10");
+    // The scale chart: 10 against 100,000 spheres with the BVH, and the tree of a
+    // million.
+    let csv = std::fs::read_to_string(root().join("chapters/charts/scale.csv")).unwrap();
+    let row = |spheres: &str| -> Vec<f64> {
+        let line = csv
+            .lines()
+            .find(|l| l.starts_with(&format!("{spheres},auto,")))
+            .unwrap_or_else(|| panic!("scale.csv has no row {spheres},auto"));
+        line.split(',')
+            .skip(2)
+            .map(|v| v.parse().unwrap())
+            .collect()
+    };
+    let (ten, many, million) = (row("10"), row("100000"), row("1000000"));
+    let quoted = format!(
+        "10 spheres take {:.0} ms a frame and 100,000 take {:.0} ms, {:.1} times as long",
+        ten[0],
+        many[0],
+        many[0] / ten[0]
+    );
+    assert!(text.contains(&quoted), "chapter 10 should say {quoted:?}");
+    for quoted in [
+        format!("tree of a million spheres is {:.0} MB", million[2] / 1e6),
+        format!("building it takes {:.0} ms", million[1]),
+    ] {
+        assert!(text.contains(&quoted), "chapter 10 should say {quoted:?}");
+    }
+    // "a little more than the number of paths a pixel traces (N + 1)".
+    let ms = |setting| chart_value(setting, 1);
+    for (setting, n) in [("spp 4", 4.0), ("spp 16", 16.0)] {
+        let times = ms(setting) / ms("default");
+        assert!(
+            times > n + 1.0 && times < 1.5 * (n + 1.0),
+            "{setting}: {times}"
+        );
+    }
+    // "saves two fifths of the rays" between two facing mirrors (exercise 3).
+    assert!(text.contains("it saves two fifths of the rays"));
+}
+
+#[test]
+fn chapter_9_quotes_the_timings_of_the_chart() {
+    let ms = |setting| chart_value(setting, 1);
+    let (default, f32, tutorial, naive) = (ms("default"), ms("f32"), ms("tutorial"), ms("naive"));
+    let saves = |t: f64| (100.0 * (1.0 - t / default)).round();
+    assert_quotes(
+        "09",
+        &format!(
+            "float32 saves {} % of a frame ({f32:.1} ms against {default:.1} ms)",
+            saves(f32)
+        ),
+    );
+    assert_quotes(
+        "09",
+        &format!("the fixed step) {} %\n({tutorial:.1} ms)", saves(tutorial)),
+    );
+    assert_quotes(
+        "09",
+        &format!("gives {naive:.1} ms against {default:.1} ms"),
+    );
+    // "costs nothing measurable": within a tenth either way in the committed chart.
+    assert!((naive / default - 1.0).abs() < 0.1);
+    // "at most a sixth of a frame": neither saving is larger.
+    assert!(f32.min(tutorial) >= default * 5.0 / 6.0);
+    assert!(chart_value("f32", 2) > 2.0 * chart_value("default", 2));
+}
+
 #[test]
 fn chapter_11_tells_the_story_explain_tells_now() {
     // The story is included from its insta snapshot (tests/explain.rs locks it);
@@ -492,4 +645,139 @@ fn chapter_11_tells_the_story_explain_tells_now() {
     assert!(story
         .to_string()
         .contains("object 0 at 2.78469 < 12.1712: in shadow"));
+}
+
+#[test]
+fn every_diagram_is_shown_with_a_caption_in_its_chapter_and_is_committed_as_drawn() {
+    use raystep::tools::diagrams::DIAGRAMS;
+    assert!(DIAGRAMS.len() >= 7, "{} diagrams", DIAGRAMS.len());
+    for diagram in DIAGRAMS {
+        let file = diagram.file();
+        let prefix = &diagram.name[2..4]; // "ch02/camera" -> "02"
+        let text = chapter(prefix);
+        // Shown by its own chapter, with alt text and a caption under it.
+        let reference = format!("](img/{file})");
+        let at = text
+            .find(&reference)
+            .unwrap_or_else(|| panic!("chapter {prefix} does not show img/{file}"));
+        assert!(images(&text).contains(&format!("img/{file}")));
+        let line_start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+        let alt = &text[line_start..at];
+        assert!(
+            alt.starts_with("![") && alt.len() > 40,
+            "chapter {prefix}: img/{file} needs alt text that says what it shows"
+        );
+        let after = &text[at + reference.len()..];
+        let caption = after.trim_start_matches('\n').lines().next().unwrap_or("");
+        assert!(
+            caption.starts_with('*'),
+            "chapter {prefix}: img/{file} needs a caption in italics under it"
+        );
+        // Committed, and what the code draws now.
+        let path = root().join("chapters/img").join(&file);
+        let committed = std::fs::read_to_string(&path)
+            .unwrap_or_else(|e| panic!("{}: {e}; run `raystep figures`", path.display()));
+        assert_eq!(
+            committed,
+            diagram.svg(&root()).unwrap(),
+            "{file} differs from what src/tools/diagrams.rs draws now; run `raystep figures`"
+        );
+    }
+}
+
+/// The rows of the Markdown tables in `text` whose first cell is a path in
+/// backticks: (path, the items in backticks of the second cell).
+fn file_rows(text: &str) -> Vec<(String, Vec<String>)> {
+    let mut rows = Vec::new();
+    for line in text.lines() {
+        let Some(rest) = line.strip_prefix("| `") else {
+            continue;
+        };
+        let cells: Vec<&str> = rest.split(" | ").collect();
+        let path = cells[0].trim_end_matches('`');
+        let items = cells.get(1).map_or(Vec::new(), |cell| {
+            cell.split('`')
+                .skip(1)
+                .step_by(2)
+                .map(String::from)
+                .collect()
+        });
+        rows.push((path.to_string(), items));
+    }
+    rows
+}
+
+/// The `.rs` files under `dir`, as paths from the repository's root.
+fn rust_files(dir: &Path, found: &mut Vec<String>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            rust_files(&path, found);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            let relative = path.strip_prefix(root()).unwrap();
+            found.push(relative.to_string_lossy().replace('\\', "/"));
+        }
+    }
+}
+
+#[test]
+fn chapter_12_names_every_file_that_names_the_stages() {
+    use raystep::stages::Stage;
+    let text = chapter("12");
+    let rows = file_rows(&text);
+    assert!(rows.len() >= 20, "chapter 12's tables: {rows:?}");
+    // Each file named exists and holds what the chapter quotes from it.
+    for (path, items) in &rows {
+        let source = std::fs::read_to_string(root().join(path))
+            .unwrap_or_else(|e| panic!("chapter 12 names {path}: {e}"));
+        assert!(!items.is_empty(), "chapter 12 quotes nothing from {path}");
+        for item in items {
+            assert!(
+                source.contains(item.as_str()),
+                "chapter 12 says {path} holds `{item}`"
+            );
+        }
+    }
+    // Every file of src/ that names a stage, the list of stages or a stage's
+    // switch is in a table.
+    let mut patterns = vec![
+        "Stage::ALL".to_string(),
+        "Stages::ALL".into(),
+        "Stages::up_to".into(),
+        "Stages::select".into(),
+    ];
+    for stage in Stage::ALL {
+        patterns.push(format!("Stage::{stage:?}"));
+        patterns.push(format!("stages.{}", stage.name().replace('-', "_")));
+    }
+    let mut files = Vec::new();
+    rust_files(&root().join("src"), &mut files);
+    let mut naming = 0;
+    for file in files {
+        let source = std::fs::read_to_string(root().join(&file)).unwrap();
+        if let Some(pattern) = patterns.iter().find(|p| source.contains(p.as_str())) {
+            naming += 1;
+            assert!(
+                rows.iter().any(|(path, _)| *path == file),
+                "{file} holds `{pattern}`: chapter 12's table should name it"
+            );
+        }
+    }
+    assert!(naming >= 10, "{naming} files of src/ name the stages");
+}
+
+#[test]
+fn no_table_row_shows_more_than_two_pictures() {
+    // At the book's width of about 750 px, three pictures in a row shrink below
+    // the 300 × 200 they are rendered at, and the differences the text points at
+    // can no longer be seen.
+    for (name, text) in chapters() {
+        for line in text.lines().filter(|l| l.starts_with('|')) {
+            let pictures = line.matches("](img/").count();
+            assert!(
+                pictures <= 2,
+                "{name}: {pictures} pictures in one row: {line}"
+            );
+        }
+    }
 }

@@ -20,7 +20,6 @@ pub trait PacketSearch {
 }
 
 impl Bvh {
-    // ANCHOR: enter_packet
     /// [`Bvh::enter`] for four rays at once, in precision `L`: where each enters
     /// the box of `node`, widened by its margin, and the lanes that enter it
     /// before their limit. `to_min` and `to_max` are the origins moved by each
@@ -46,6 +45,7 @@ impl Bvh {
     /// an origin exactly on a stored face with the direction parallel to it, and
     /// such a ray passes `32u·R` outside the exact box, which any answer skips
     /// rightly or visits in vain.
+    // ANCHOR: enter_packet
     #[inline(always)]
     fn enter_packet<L: Laned>(
         node: &Node,

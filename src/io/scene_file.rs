@@ -471,6 +471,9 @@ struct CameraKeys {
     position: Triple, // required
 }
 
+// ANCHOR_END: schema
+
+// ANCHOR: schema_light
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ScreenKeys {
@@ -495,6 +498,9 @@ struct RenderKeys {
     max_depth: Option<u32>, // default 3
 }
 
+// ANCHOR_END: schema_light
+
+// ANCHOR: schema_objects
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SphereKeys {
@@ -527,8 +533,7 @@ struct SphereShape {
     center: Triple,
     radius: f64,
 }
-
-// ANCHOR_END: schema
+// ANCHOR_END: schema_objects
 
 /// The material keys that `[[sphere]]` and `[[plane]]` share. (serde cannot both
 /// flatten a shared struct and refuse unknown keys, so each section lists them.)

@@ -14,7 +14,7 @@ pub enum Viewer {
     RayOrigin,
 }
 
-// ANCHOR: terms
+// ANCHOR: terms_struct
 /// The three terms of Blinn-Phong at one point, and the factors they come from
 /// (what `raystep explain` prints and the `diffuse` and `specular` buffers hold).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,6 +41,9 @@ impl<T: Real> Terms<T> {
     }
 }
 
+// ANCHOR_END: terms_struct
+
+// ANCHOR: terms
 /// The terms of Blinn-Phong at a point.
 ///
 /// `normal` is the surface normal N, `to_light` the unit vector L towards the light

@@ -1,7 +1,9 @@
-//! The book's pictures. Every image in `chapters/img/` is listed here as the
+//! The book's pictures. Every render in `chapters/img/` is listed here as the
 //! `raystep render` command a reader would type, and `raystep figures` runs those
 //! very commands, so the command printed beside a picture is the one that made it.
-//! `raystep figures --check` re-renders them all and compares the bytes.
+//! The diagrams (SVG) are drawn by [`crate::tools::diagrams`] from the crate's own
+//! geometry. `raystep figures --check` re-renders and redraws them all and compares
+//! the bytes.
 
 use std::path::{Path, PathBuf};
 
@@ -82,7 +84,8 @@ pub fn contact_sheet() -> Vec<u8> {
     sheet.png()
 }
 
-/// Every file `raystep figures` writes under `chapters/img/`: (file, bytes).
+/// Every file `raystep figures` writes under `chapters/img/`: (file, bytes, what
+/// makes it).
 fn every_file(root: &Path, run: Renderer) -> Result<Vec<(String, Vec<u8>, String)>, Error> {
     let mut files = Vec::new();
     for figure in FIGURES {
@@ -95,6 +98,13 @@ fn every_file(root: &Path, run: Renderer) -> Result<Vec<(String, Vec<u8>, String
         contact_sheet(),
         "raystep stages".to_string(),
     ));
+    for diagram in crate::tools::diagrams::DIAGRAMS {
+        files.push((
+            diagram.file(),
+            diagram.svg(root)?.into_bytes(),
+            format!("the diagram {} of src/tools/diagrams.rs", diagram.name),
+        ));
+    }
     Ok(files)
 }
 
@@ -124,8 +134,8 @@ impl Figure {
     }
 }
 
-/// Render every figure into `out` (normally `chapters/img`); scenes are read
-/// relative to `root`. Returns the files written.
+/// Render every figure and draw every diagram into `out` (normally
+/// `chapters/img`); scenes are read relative to `root`. Returns the files written.
 pub fn write_all(root: &Path, out: &Path, run: Renderer) -> Result<Vec<PathBuf>, Error> {
     let mut written = Vec::new();
     for (file, bytes, _) in every_file(root, run)? {
@@ -142,8 +152,9 @@ pub fn write_all(root: &Path, out: &Path, run: Renderer) -> Result<Vec<PathBuf>,
     Ok(written)
 }
 
-/// Re-render every figure and compare with the files in `out`: the problems found
-/// (a missing file, different bytes, a PNG in `out` that no figure makes).
+/// Re-render every figure and redraw every diagram, and compare with the files in
+/// `out`: the problems found (a missing file, different bytes, a PNG or SVG in
+/// `out` that nothing makes).
 pub fn check_all(root: &Path, out: &Path, run: Renderer) -> Result<Vec<String>, Error> {
     let mut problems = Vec::new();
     let mut expected = Vec::new();
@@ -158,15 +169,19 @@ pub fn check_all(root: &Path, out: &Path, run: Renderer) -> Result<Vec<String>, 
         }
         expected.push(path);
     }
-    for path in png_files(out) {
+    for path in image_files(out) {
         if !expected.contains(&path) {
-            problems.push(format!("{}: no figure makes this image", path.display()));
+            problems.push(format!(
+                "{}: no figure or diagram makes this image",
+                path.display()
+            ));
         }
     }
     Ok(problems)
 }
 
-fn png_files(dir: &Path) -> Vec<PathBuf> {
+/// The PNG and SVG files under `dir`, at any depth.
+fn image_files(dir: &Path) -> Vec<PathBuf> {
     let mut found = Vec::new();
     let Ok(entries) = std::fs::read_dir(dir) else {
         return found;
@@ -174,8 +189,8 @@ fn png_files(dir: &Path) -> Vec<PathBuf> {
     for entry in entries.flatten() {
         let path = entry.path();
         if path.is_dir() {
-            found.extend(png_files(&path));
-        } else if path.extension().is_some_and(|e| e == "png") {
+            found.extend(image_files(&path));
+        } else if path.extension().is_some_and(|e| e == "png" || e == "svg") {
             found.push(path);
         }
     }

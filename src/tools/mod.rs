@@ -1,11 +1,13 @@
 //! The commands around the renderer: the command line, `explain`, `accuracy`,
-//! `bench` and its yardstick, `chart`, `diff`, the book's figures and `generate`.
+//! `bench` and its yardstick, `chart`, `diff`, the book's figures and diagrams, and
+//! `generate`.
 
 pub mod accuracy;
 pub mod bench;
 pub mod chart;
 pub mod cli;
 pub mod compare;
+pub mod diagrams;
 pub mod explain;
 pub mod figures;
 pub mod generate;

@@ -1,0 +1,373 @@
+//! Chapter 12's worked example, built and run: ambient occlusion as a seventh
+//! stage, `occlusion`, written on the crate's public API.
+//!
+//! A real stage changes `Tracer::trace` in `src/render.rs`. Until it is ready to go
+//! there, it lives here: [`trace`] is a copy of that loop with the stage's lines
+//! and a switch for them. The tests check what the chapter says: with the switch
+//! off the copy gives the book's bits for every pixel; with it on the picture only
+//! darkens, only where a neighbour is within reach, by the numbers the chapter
+//! quotes.
+//!
+//! `RAYSTEP_OWN_STAGE_PNG=1 cargo test --test own_stage` also writes the pictures
+//! (`own-stage-off.png`, `own-stage-on.png`, `own-stage-buffer.png`) into the
+//! system's temporary folder, to look at.
+
+mod common;
+
+use std::f64::consts::TAU;
+
+use raystep::aov::{Buffer, FirstHit, Frame, PixelRecord};
+use raystep::io::output::png_bytes;
+use raystep::ray::Ray;
+use raystep::real::Precision;
+use raystep::render::{Settings, Traced, Tracer, HALF_STEP};
+use raystep::scene::{Object, Scene, Shape};
+use raystep::shade::blinn_phong::{self, Viewer};
+use raystep::shade::{reflection, shadow};
+use raystep::stages::{Stage, Stages};
+use raystep::tools::compare::compare;
+use raystep::Vec3;
+
+// ANCHOR: occlusion
+/// How far a probe looks for a neighbour, in scene units.
+const RADIUS: f64 = 0.5;
+/// How many probes leave each point.
+const PROBES: u32 = 8;
+
+/// The share of the probes from `shifted` that meet an object closer than
+/// [`RADIUS`]: 0 in the open, 1 where every probe is blocked.
+fn occlusion(tracer: &Tracer, shifted: Vec3, normal: Vec3) -> f64 {
+    // Two unit vectors at right angles to the normal and to each other.
+    let helper = if normal.x.abs() < 0.9 {
+        Vec3::X
+    } else {
+        Vec3::Y
+    };
+    let across = normal.cross(helper).normalize();
+    let along = normal.cross(across);
+    let mut blocked = 0;
+    for i in 0..PROBES {
+        // Evenly spaced round the normal, each 45° away from it.
+        let turn = TAU * f64::from(i) / f64::from(PROBES);
+        let sideways = across * turn.cos() + along * turn.sin();
+        let probe = (normal + sideways).normalize();
+        // Chapter 4's question: is anything along this ray, closer than this?
+        if tracer.in_shadow(shifted, probe, RADIUS) {
+            blocked += 1;
+        }
+    }
+    f64::from(blocked) / f64::from(PROBES)
+}
+// ANCHOR_END: occlusion
+
+/// What the copy of the loop gives for one pixel.
+struct Path {
+    /// The colour and first hit, as `Tracer::trace` returns them.
+    traced: Traced,
+    /// The new buffer: the first hit's occlusion; −1 on a miss, 0 where none was
+    /// computed (the stage off, or the point in shadow).
+    occlusion: f64,
+    /// Each point whose ambient term the stage dimmed: the point, the object it
+    /// is on, and its occlusion, in the order of the path.
+    dimmed: Vec<(Vec3, usize, f64)>,
+    /// The probes the stage cast.
+    probes: u32,
+}
+
+/// `Tracer::trace` of `src/render.rs`, line for line but for the observer, with
+/// the `occlusion` stage's lines switched on by `occlusion_on`.
+fn trace(tracer: &Tracer, primary: Ray, occlusion_on: bool) -> Path {
+    let segments = if tracer.stages.reflection {
+        tracer.max_depth
+    } else {
+        1
+    };
+    let mut colour = Vec3::ZERO;
+    let mut weight = 1.0;
+    let mut ray = primary;
+    let mut first = None;
+    let (mut first_occlusion, mut dimmed, mut probes) = (-1.0, Vec::new(), 0);
+    for segment in 0..segments {
+        let Some(hit) = tracer.nearest_hit(&ray) else {
+            break;
+        };
+        let object = &tracer.objects[hit.object];
+        let point = ray.at(hit.t);
+        let normal = object.normal_at(point, &ray);
+        let shifted = shadow::step_off(point, normal, object, tracer.offset);
+        let to_light = (tracer.light.position - shifted).normalize();
+        let lit = !tracer.stages.shadow || {
+            let light_distance = tracer.light.position.distance(point);
+            !tracer.in_shadow(shifted, to_light, light_distance)
+        };
+        // ANCHOR: shading
+        let mut occluded = 0.0;
+        let terms = (lit && tracer.stages.blinn_phong).then(|| {
+            let viewer = match tracer.viewer {
+                Viewer::Camera => tracer.camera.position,
+                Viewer::RayOrigin => ray.origin,
+            };
+            let to_viewer = (viewer - point).normalize();
+            let mut terms =
+                blinn_phong::terms(&object.material, &tracer.light, normal, to_light, to_viewer);
+            // The new stage: keep the share of ambient light the probes let in.
+            if occlusion_on {
+                occluded = occlusion(tracer, shifted, normal);
+                terms.ambient *= 1.0 - occluded;
+            }
+            terms
+        });
+        // ANCHOR_END: shading
+        if terms.is_some() && occlusion_on {
+            probes += PROBES;
+        }
+        if occluded > 0.0 {
+            dimmed.push((point, hit.object, occluded));
+        }
+        if segment == 0 {
+            first_occlusion = occluded;
+            first = Some(FirstHit {
+                depth: hit.t,
+                normal,
+                lit,
+                object: hit.object,
+                diffuse: terms.map_or(0.0, |t| t.l_dot_n),
+                specular: terms.map_or(0.0, |t| t.highlight),
+            });
+        }
+        if !lit {
+            break;
+        }
+        let illumination = terms.map_or(object.material.diffuse, |t| t.sum());
+        colour += illumination * weight;
+        weight *= object.material.reflection;
+        ray = reflection::reflected_ray(shifted, &ray, normal);
+        let left = (segments - segment - 1) as usize;
+        if tracer
+            .reach
+            .get(left)
+            .is_some_and(|r| weight * r < HALF_STEP)
+        {
+            break;
+        }
+    }
+    Path {
+        traced: Traced {
+            colour: colour.clamp(Vec3::ZERO, Vec3::ONE),
+            first,
+        },
+        occlusion: first_occlusion,
+        dimmed,
+        probes,
+    }
+}
+
+/// Every pixel of `scene` under `settings`, row by row, traced by the copy.
+fn render(scene: &Scene, settings: &Settings, occlusion_on: bool) -> Vec<Path> {
+    let tracer = Tracer::<f64>::new(scene, settings);
+    let camera = tracer.camera;
+    (0..camera.height)
+        .flat_map(|row| (0..camera.width).map(move |col| (row, col)))
+        .map(|(row, col)| trace(&tracer, camera.primary_ray(row, col), occlusion_on))
+        .collect()
+}
+
+/// The figure-1 scene at its size, 300 × 200, traced by the copy with every
+/// stage of the book on, without and with the new stage.
+fn seed_off_and_on() -> (Vec<Path>, Vec<Path>) {
+    let (scene, settings) = (common::seed(300, 200), Settings::from(Stages::ALL));
+    (
+        render(&scene, &settings, false),
+        render(&scene, &settings, true),
+    )
+}
+
+/// The beauty buffer of `paths`, as a frame stores it (float32).
+fn beauty(paths: &[Path]) -> Vec<[f32; 3]> {
+    paths
+        .iter()
+        .map(|p| p.traced.colour.as_vec3().to_array())
+        .collect()
+}
+
+/// The distance from `p` to the surface of `object`.
+fn distance_to(object: &Object, p: Vec3) -> f64 {
+    match object.shape {
+        Shape::Sphere(s) => p.distance(s.center) - s.radius,
+        Shape::Plane(q) => (p - q.point).dot(q.normal).abs(),
+    }
+}
+
+/// The distance from `p` to the nearest object of `scene` other than `own`.
+fn neighbour_distance(scene: &Scene, own: usize, p: Vec3) -> f64 {
+    let objects = scene.objects.iter().enumerate();
+    objects
+        .filter(|&(i, _)| i != own)
+        .map(|(_, o)| distance_to(o, p))
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn with_the_stage_off_the_copy_gives_the_books_bits() {
+    let scene = common::seed(300, 200);
+    for stage in Stage::ALL.into_iter().filter(|&s| s >= Stage::Intersection) {
+        let stages = Stages::up_to(stage);
+        for settings in [Settings::from(stages), Settings::tutorial(stages)] {
+            let tracer = Tracer::<f64>::new(&scene, &settings);
+            let paths = render(&scene, &settings, false);
+            for (i, path) in paths.iter().enumerate() {
+                let (row, col) = (i as u32 / 300, i as u32 % 300);
+                let book = tracer.pixel(row, col, &mut ());
+                assert_eq!(path.traced, book, "{stage}: pixel ({row}, {col})");
+                assert_eq!((path.probes, path.dimmed.len()), (0, 0));
+            }
+        }
+    }
+    // The default render, as `raystep render` makes it: the same picture.
+    let frame = common::render(&scene, Stages::ALL);
+    let book: Vec<[f32; 3]> = frame.pixels.iter().map(|p| p.colour).collect();
+    assert_eq!(beauty(&seed_off_and_on().0), book);
+}
+
+// ANCHOR: only_darkens
+#[test]
+fn occlusion_only_darkens_and_only_near_a_neighbour() {
+    let scene = common::seed(300, 200);
+    let (off, on) = seed_off_and_on();
+    for (i, (off, on)) in off.iter().zip(&on).enumerate() {
+        // No channel of any pixel gets brighter.
+        let (before, after) = (off.traced.colour, on.traced.colour);
+        assert!(after.cmple(before).all(), "pixel {i} got brighter");
+        // A path the stage did not dim keeps its bits.
+        if on.dimmed.is_empty() {
+            assert_eq!(on.traced, off.traced, "pixel {i}");
+        }
+        // Every point it dimmed has another object within reach.
+        for &(point, object, _) in &on.dimmed {
+            let gap = neighbour_distance(&scene, object, point);
+            assert!(gap < RADIUS, "pixel {i}: dimmed {gap} from the nearest");
+        }
+    }
+}
+// ANCHOR_END: only_darkens
+
+#[test]
+fn the_occlusion_buffer_is_minus_one_on_a_miss_and_zero_in_shadow() {
+    let (_, on) = seed_off_and_on();
+    for path in &on {
+        match path.traced.first {
+            None => assert_eq!(path.occlusion, -1.0),
+            Some(hit) if !hit.lit => assert_eq!(path.occlusion, 0.0),
+            Some(_) => assert!((0.0..=1.0).contains(&path.occlusion)),
+        }
+    }
+}
+
+/// Where the red sphere stands on the floor.
+const CONTACT: Vec3 = Vec3::new(-0.2, -0.7, -1.0);
+
+#[test]
+fn the_numbers_chapter_12_quotes() {
+    let (off, on) = seed_off_and_on();
+    let lit = |p: &&Path| p.traced.first.is_some_and(|f| f.lit);
+    let lit_hits = on.iter().filter(lit).count();
+    let touched = on.iter().filter(|p| p.occlusion > 0.0).count();
+    let buried: Vec<usize> = (0..on.len()).filter(|&i| on[i].occlusion == 1.0).collect();
+    let d = compare(&beauty(&off), &beauty(&on), 300);
+    let probes: u64 = on.iter().map(|p| u64::from(p.probes)).sum();
+    let rays = common::render(&common::seed(300, 200), Stages::ALL).rays;
+    assert_eq!((lit_hits, touched, buried.len()), (30_945, 8_591, 52));
+    assert_eq!((d.over_one_step, d.largest_at), (8_633, (150, 149)));
+    assert_eq!((probes, rays.total()), (298_512, 139_311));
+    assert!(probes > 2 * rays.total(), "the rays more than triple");
+    // Every buried point lies within 0.3 of where the red sphere meets the floor.
+    let camera = common::seed(300, 200).camera();
+    for &i in &buried {
+        let ray = camera.primary_ray::<f64>(i as u32 / 300, i as u32 % 300);
+        let point = ray.at(on[i].traced.first.unwrap().depth);
+        assert!(point.distance(CONTACT) < 0.3, "{point}");
+    }
+    // The largest change: the red sphere's underside, 6 of 8 probes blocked, and
+    // the floor it reflects, 5 of 8 blocked, at half weight.
+    let largest = &on[150 * 300 + 149];
+    let dimmed: Vec<(usize, f64)> = largest.dimmed.iter().map(|d| (d.1, d.2)).collect();
+    assert_eq!(dimmed, [(0, 0.75), (3, 0.625)]);
+    // The floor (object 3) is the only neighbour within reach of the first point.
+    let scene = common::seed(300, 200);
+    let (first, _, _) = largest.dimmed[0];
+    let objects = scene.objects.iter().enumerate().skip(1);
+    let near: Vec<usize> = objects
+        .filter(|(_, o)| distance_to(o, first) < RADIUS)
+        .map(|(i, _)| i)
+        .collect();
+    assert_eq!(near, [3]);
+    assert!((f64::from(d.largest) - (0.75 * 0.1 + 0.5 * 0.625 * 0.1)).abs() < 1e-6);
+
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/chapters/12-your-own-stage.md"
+    ))
+    .unwrap();
+    // The words of the chapter, whatever the line breaks.
+    let text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let percent = 100.0 * d.over_one_step as f64 / d.pixels as f64;
+    for quoted in [
+        format!(
+            "Of the {} pixels whose first hit is lit, {} have",
+            grouped(lit_hits),
+            grouped(touched)
+        ),
+        format!("{} are buried: all eight", buried.len()),
+        format!(
+            "{} pixels ({percent:.2} %) change",
+            grouped(d.over_one_step)
+        ),
+        format!("by {:.4}, at row 150, column 149", d.largest),
+        format!(
+            "{} probes, against {} rays",
+            grouped(probes as usize),
+            grouped(rays.total() as usize)
+        ),
+    ] {
+        assert!(text.contains(&quoted), "chapter 12 should say {quoted:?}");
+    }
+    show(&off, &on);
+}
+
+/// `n` with a comma between each group of three digits, as the book writes it.
+fn grouped(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, digit) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(digit);
+    }
+    out
+}
+
+/// With `RAYSTEP_OWN_STAGE_PNG` set, write the pictures without and with the
+/// stage, and the new buffer (white in the open, black where every probe is
+/// blocked, dark blue on a miss), into the system's temporary folder.
+fn show(off: &[Path], on: &[Path]) {
+    if std::env::var_os("RAYSTEP_OWN_STAGE_PNG").is_none() {
+        return;
+    }
+    let buffer: Vec<[f32; 3]> = on
+        .iter()
+        .map(|p| match p.occlusion {
+            o if o < 0.0 => [0.0, 0.0, 0.5],
+            o => [1.0 - o as f32; 3],
+        })
+        .collect();
+    for (name, colours) in [("off", beauty(off)), ("on", beauty(on)), ("buffer", buffer)] {
+        let mut frame = Frame::blank(common::seed(300, 200).camera(), Precision::F64);
+        for (record, &colour) in frame.pixels.iter_mut().zip(&colours) {
+            *record = PixelRecord::missed(colour, 0, 0);
+        }
+        let path = std::env::temp_dir().join(format!("own-stage-{name}.png"));
+        std::fs::write(&path, png_bytes(&frame, Buffer::Beauty)).unwrap();
+        eprintln!("wrote {}", path.display());
+    }
+}
