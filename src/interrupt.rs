@@ -6,7 +6,9 @@
 //! [`crate::io::output::Pending`]). Work that does not look at the flag (reading a
 //! FIFO that nobody writes, a benchmark's runs, the accuracy measurements) is ended
 //! by a watchdog [`GRACE`] later: it waits for any renaming under way to finish
-//! ([`files`]), removes the temporary files of this process, and exits. A second
+//! ([`files`]), removes the temporary files of this process, and exits, unless the
+//! new files were put in place meanwhile ([`committed`]): the command then ends by
+//! itself, with its own exit code. A second
 //! signal ends the process at once; the temporary files it leaves are removed by
 //! the next run that writes to the same folder.
 
@@ -16,6 +18,10 @@ use std::sync::{Mutex, MutexGuard};
 use std::time::Duration;
 
 static REQUESTED: AtomicBool = AtomicBool::new(false);
+
+/// Set once a set of files has been put in place ([`committed`]): the command's
+/// work is then done, and it is left to end by itself with its own exit code.
+static COMMITTED: AtomicBool = AtomicBool::new(false);
 
 /// What this process has made and not yet committed or removed, in the order it
 /// made them: temporary files, and the folders created for them (`true`). The
@@ -42,6 +48,13 @@ pub fn install() {
             // Not in the middle of a commit: remove what was made, newest first
             // (a folder is removed only if empty, as the commit would have left it).
             let made = files();
+            if COMMITTED.load(Ordering::SeqCst) {
+                // The signal came too late: the new files are in place, and the
+                // command ends by itself (exit 0) once it has said so. Ending it
+                // with 130 here, on a busy machine, would report an interrupted
+                // run whose files were all written.
+                return;
+            }
             for (path, folder) in made.iter().rev() {
                 let _ = match folder {
                     true => std::fs::remove_dir(path),
@@ -69,6 +82,11 @@ pub fn files() -> MutexGuard<'static, Vec<(PathBuf, bool)>> {
 /// for the watchdog to remove.
 pub fn made(path: &Path, folder: bool) {
     files().push((path.to_path_buf(), folder));
+}
+
+/// The files of this run were put in place (called under the lock of [`files`]).
+pub fn committed() {
+    COMMITTED.store(true, Ordering::SeqCst);
 }
 
 /// `path` was committed (renamed, or kept) or removed.

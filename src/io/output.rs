@@ -321,6 +321,7 @@ impl Pending {
         // The folders made for the files now hold them.
         noted.retain(|(p, _)| !self.created.contains(p));
         self.created.clear();
+        crate::interrupt::committed();
         Ok(())
     }
 
