@@ -26,8 +26,8 @@
 pub enum Accel {
     /// Test every object for every ray: the book's plain loop.
     Off,
-    /// A BVH from [`BVH_FROM`] spheres on; in the fast engine also tile masks for
-    /// primary rays.
+    /// A BVH from 24 spheres on (the constant BVH_FROM); in the fast engine also
+    /// tile masks for primary rays.
     #[default]
     Auto,
     /// A BVH whatever the number of spheres (but never with `--intersect naive`).

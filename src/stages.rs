@@ -9,12 +9,12 @@ use std::fmt;
 /// Which tracer renders (`--engine`). Both give the same bits for every pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum Engine {
-    /// The tracer the chapters show, one ray at a time in plain code
-    /// ([`crate::render`]): the default wherever a reader looks at pictures.
+    /// The tracer the chapters show, one ray at a time in plain code (the module
+    /// render): the default wherever a reader looks at pictures.
     #[default]
     Book,
     /// The same tracer, four rays at a time in SIMD lanes, with tile masks and a
-    /// packet walk of the BVH ([`crate::fast`]): `raystep bench` and `chart`. It
+    /// packet walk of the BVH (the module fast): the default of raystep bench and chart. It
     /// traces what it does not support with the book's engine.
     Fast,
 }

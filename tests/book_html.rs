@@ -8,7 +8,7 @@
 //!   (`tests/browser/book.mjs`) with every request intercepted: no console error,
 //!   no failed load, no request that leaves the machine, fractions and
 //!   superscripts laid out as maths. One screenshot per page goes to
-//!   `$TMPDIR/raystep-book-screenshots/` for a person to look at.
+//!   `target/tmp/book-screenshots/` for a person to look at.
 //!
 //! Needs mdbook and mdbook-katex at the pinned versions in `$CARGO_HOME/bin`
 //! (`.ci/run` installs them), and for the second test Chromium
@@ -383,8 +383,10 @@ fn every_page_of_the_built_book_renders_offline_in_chromium() {
     let book = build(&bin);
     let pages = pages();
 
-    // Screenshots outside the repository, kept for a person to look at.
-    let shots = std::env::temp_dir().join("raystep-book-screenshots");
+    // Screenshots outside the sources, kept for a person to look at: in this
+    // build's own temporary folder, so that two checkouts tested at once (or two
+    // users) never clear each other's.
+    let shots = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("book-screenshots");
     let _ = std::fs::remove_dir_all(&shots);
     std::fs::create_dir_all(&shots).unwrap();
     let mut browse = Command::new("node");

@@ -29,10 +29,12 @@ fn no_arguments_renders_every_stage_of_the_built_in_scene_from_any_folder() {
     let dir = tempfile::tempdir().unwrap();
     let out = raystep(dir.path(), &[]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    // Quiet on stderr when it is not a terminal: no progress bar, no warnings.
-    assert_eq!(text(&out.stderr), "");
-    let stdout = text(&out.stdout);
-    assert!(stdout.contains("wrote 6 stages"), "{stdout}");
+    // Nothing on stdout, which is for data; the status lines on stderr, with no
+    // progress bar (stderr is not a terminal) and no warnings.
+    assert_eq!(text(&out.stdout), "");
+    let stderr = text(&out.stderr);
+    assert!(stderr.contains("wrote 6 stages"), "{stderr}");
+    assert!(!stderr.contains("warning"), "{stderr}");
     for (folder, files) in [
         (
             "01-rays",
@@ -98,7 +100,8 @@ fn render_writes_one_configuration_at_the_size_asked_and_no_temporary_files() {
     ];
     let out = raystep(dir.path(), &args);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stdout).contains("rays+intersection+blinn-phong+reflection+plane"));
+    assert_eq!(text(&out.stdout), "", "stdout is for data");
+    assert!(text(&out.stderr).contains("rays+intersection+blinn-phong+reflection+plane"));
     let mut names: Vec<String> = std::fs::read_dir(dir.path().join("here"))
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -217,7 +220,7 @@ fn diff_compares_two_renders_and_refuses_two_sizes() {
     );
 
     let same = run(&["diff", "a/buffers.exr", "a/buffers.exr"]);
-    assert!(same.status.success());
+    assert_eq!(same.status.code(), Some(0), "the same: exit 0");
     assert!(
         text(&same.stdout).contains("differ by more than 1/255: 0 pixels (0.00 %)"),
         "{}",
@@ -225,7 +228,11 @@ fn diff_compares_two_renders_and_refuses_two_sizes() {
     );
 
     let other = run(&["diff", "a/buffers.exr", "b/buffers.exr"]);
-    assert!(other.status.success());
+    assert_eq!(
+        other.status.code(),
+        Some(1),
+        "different: exit 1, as diff and cmp"
+    );
     assert!(!text(&other.stdout).contains("differ by more than 1/255: 0 pixels"));
 
     let sizes = run(&["diff", "a/buffers.exr", "small/buffers.exr"]);
@@ -344,4 +351,332 @@ fn chart_writes_its_csv_svg_and_png() {
     assert!(std::fs::read_to_string(dir.path().join("c/chart.svg"))
         .unwrap()
         .starts_with("<svg"));
+}
+
+/// Run raystep in `dir` with `input` on its standard input.
+fn raystep_with_input(dir: &Path, args: &[&str], input: &[u8]) -> std::process::Output {
+    use std::io::Write;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_raystep"))
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(input).unwrap();
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+fn diff_exits_0_same_1_different_2_trouble_with_a_threshold() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |args: &[&str]| raystep(dir.path(), args);
+    for (out, stage) in [("a", "plane"), ("b", "reflection")] {
+        let made = run(&[
+            "render", "-q", "--width", "40", "--height", "30", "--stage", stage, "-o", out,
+        ]);
+        assert!(made.status.success(), "{}", text(&made.stderr));
+    }
+    let code = |args: &[&str]| run(args).status.code();
+    assert_eq!(code(&["diff", "a/buffers.exr", "a/buffers.exr"]), Some(0));
+    assert_eq!(code(&["diff", "a/buffers.exr", "b/buffers.exr"]), Some(1));
+    // A tolerance above any difference of colour: the same.
+    assert_eq!(
+        code(&["diff", "a/buffers.exr", "b/buffers.exr", "--threshold", "2"]),
+        Some(0)
+    );
+    // As many pixels allowed to differ as do: the same; one fewer: different.
+    let json = run(&["diff", "a/buffers.exr", "b/buffers.exr", "--json"]);
+    assert_eq!(json.status.code(), Some(1));
+    let report: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let over = report["over_threshold_percent"].as_f64().unwrap();
+    assert!(over > 0.0, "{report}");
+    let at = format!("{over}");
+    assert_eq!(
+        code(&[
+            "diff",
+            "a/buffers.exr",
+            "b/buffers.exr",
+            "--fail-percent",
+            &at
+        ]),
+        Some(0)
+    );
+    // Trouble: a missing file, a bad threshold, a missing argument.
+    assert_eq!(code(&["diff", "a/buffers.exr", "none.exr"]), Some(2));
+    assert_eq!(
+        code(&[
+            "diff",
+            "a/buffers.exr",
+            "a/buffers.exr",
+            "--threshold",
+            "-1"
+        ]),
+        Some(2)
+    );
+    assert_eq!(code(&["diff", "a/buffers.exr"]), Some(2));
+}
+
+#[test]
+fn json_outputs_carry_schema_1_and_the_documented_fields() {
+    let dir = tempfile::tempdir().unwrap();
+    let seed = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/seed.toml");
+    let json = |args: &[&str]| -> serde_json::Value {
+        let out = raystep(dir.path(), args);
+        assert!(
+            matches!(out.status.code(), Some(0 | 1)),
+            "{args:?}: {}",
+            text(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|e| panic!("{args:?}: {e}: {}", text(&out.stdout)))
+    };
+    let has = |value: &serde_json::Value, keys: &[&str]| {
+        assert_eq!(value["schema"], 1, "{value}");
+        for key in keys {
+            assert!(value.get(key).is_some(), "{key} in {value}");
+        }
+    };
+
+    let render = json(&[
+        "render", "--width", "24", "--height", "16", "-o", "r", "--json",
+    ]);
+    has(
+        &render,
+        &[
+            "scene",
+            "width",
+            "height",
+            "stages",
+            "engine",
+            "precision",
+            "spp",
+            "out",
+            "files",
+            "buffers",
+            "seconds",
+            "rays",
+        ],
+    );
+    let files = render["files"].as_array().unwrap();
+    assert_eq!(files.len(), 12, "eleven pictures and the EXR: {render}");
+    for file in files {
+        let path = dir.path().join(file["path"].as_str().unwrap());
+        let bytes = std::fs::metadata(&path).unwrap().len();
+        assert_eq!(file["bytes"].as_u64(), Some(bytes), "{}", path.display());
+    }
+    assert_eq!(render["buffers"].as_array().unwrap().len(), 11);
+    for key in ["render", "write", "total"] {
+        assert!(render["seconds"][key].as_f64().unwrap() >= 0.0, "{render}");
+    }
+    assert_eq!(render["rays"]["primary"].as_u64(), Some(24 * 16));
+    assert!(render["rays"]["total"].as_u64().unwrap() >= 24 * 16);
+
+    let check = json(&["check", seed, "--json"]);
+    has(
+        &check,
+        &[
+            "scene",
+            "valid",
+            "width",
+            "height",
+            "max_depth",
+            "camera",
+            "screen",
+            "light",
+            "spheres",
+            "planes",
+            "objects",
+        ],
+    );
+    assert_eq!(check["valid"], true);
+    assert_eq!(
+        check["objects"].as_array().unwrap().len() as u64,
+        check["spheres"].as_u64().unwrap() + check["planes"].as_u64().unwrap()
+    );
+
+    let diff = json(&["diff", "r/buffers.exr", "r/buffers.exr", "--json"]);
+    has(
+        &diff,
+        &[
+            "a",
+            "b",
+            "width",
+            "height",
+            "pixels",
+            "threshold",
+            "fail_percent",
+            "over_threshold",
+            "over_threshold_percent",
+            "over_one_step",
+            "largest",
+            "largest_at",
+            "rmse",
+            "clipped",
+            "non_finite",
+            "different",
+        ],
+    );
+    assert_eq!(diff["different"], false);
+    assert_eq!(diff["pixels"].as_u64(), Some(24 * 16));
+
+    let explain = json(&["explain", "--pixel", "1,1", "--json"]);
+    has(&explain, &["depth"]);
+    let bench = json(&[
+        "bench",
+        "--width",
+        "16",
+        "--height",
+        "9",
+        "--runs",
+        "1",
+        "--no-yardstick",
+        "--json",
+    ]);
+    has(&bench, &["median_s", "rays"]);
+    let accuracy = json(&["accuracy", "--case", "far-sphere", "--json"]);
+    for row in accuracy.as_array().unwrap() {
+        assert_eq!(row["schema"], 1, "{row}");
+    }
+}
+
+#[test]
+fn status_lines_go_to_stderr_and_quiet_silences_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let size = ["--width", "24", "--height", "16"];
+    for command in ["render", "stages"] {
+        let mut args = vec![command];
+        args.extend(size);
+        let out = raystep(dir.path(), &args);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        assert_eq!(text(&out.stdout), "", "{command}: stdout is for data");
+        let stderr = text(&out.stderr);
+        assert!(stderr.contains("24 × 16"), "{command}: {stderr}");
+        assert!(stderr.contains("beauty.png"), "{command}: {stderr}");
+        for quiet in ["-q", "--quiet"] {
+            let mut args = vec![quiet, command];
+            args.extend(size);
+            let out = raystep(dir.path(), &args);
+            assert!(out.status.success(), "{}", text(&out.stderr));
+            assert_eq!(text(&out.stdout), "", "{quiet} {command}");
+            assert_eq!(text(&out.stderr), "", "{quiet} {command}");
+        }
+    }
+    // --quiet is global: after the command too, and --json still prints.
+    let out = raystep(
+        dir.path(),
+        &[
+            "render", "--width", "8", "--height", "8", "--json", "--quiet",
+        ],
+    );
+    assert_eq!(text(&out.stderr), "");
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["width"], 8);
+}
+
+#[test]
+fn completions_and_a_man_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let bash = raystep(dir.path(), &["completions", "bash"]);
+    assert!(bash.status.success(), "{}", text(&bash.stderr));
+    let script = text(&bash.stdout);
+    assert!(script.contains("raystep"), "{script}");
+    assert!(script.contains("complete"), "{script}");
+    for shell in ["zsh", "fish", "elvish", "powershell"] {
+        let out = raystep(dir.path(), &["completions", shell]);
+        assert!(out.status.success(), "{shell}");
+        assert!(text(&out.stdout).contains("raystep"), "{shell}");
+    }
+    assert_eq!(
+        raystep(dir.path(), &["completions", "tcsh"]).status.code(),
+        Some(2)
+    );
+    let man = raystep(dir.path(), &["man"]);
+    assert!(man.status.success(), "{}", text(&man.stderr));
+    let page = text(&man.stdout);
+    let first = page
+        .lines()
+        .find(|l| !l.starts_with(".ie") && !l.starts_with(".el"));
+    assert!(first.unwrap().starts_with(".TH raystep 1"), "{page}");
+    assert!(page.contains("render"), "{page}");
+}
+
+#[test]
+fn a_scene_on_stdin_and_output_aliases() {
+    let dir = tempfile::tempdir().unwrap();
+    let seed = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/seed.toml")).unwrap();
+    let check = raystep_with_input(dir.path(), &["check", "-"], &seed);
+    assert!(check.status.success(), "{}", text(&check.stderr));
+    assert!(text(&check.stdout).starts_with("<stdin>: a valid scene"));
+    let broken = raystep_with_input(dir.path(), &["check", "-"], b"[camera]\nposition = 3\n");
+    assert_eq!(broken.status.code(), Some(2));
+    assert!(
+        text(&broken.stderr).starts_with("error: <stdin>: "),
+        "{}",
+        text(&broken.stderr)
+    );
+    for (flag, folder) in [("-o", "short"), ("--output", "long"), ("--out", "out")] {
+        let args = [
+            "render", "-", "--width", "12", "--height", "8", flag, folder,
+        ];
+        let out = raystep_with_input(dir.path(), &args, &seed);
+        assert!(out.status.success(), "{flag}: {}", text(&out.stderr));
+        assert!(text(&out.stderr).starts_with("<stdin>: "), "{flag}");
+        assert_eq!(
+            png_size(&dir.path().join(folder).join("beauty.png")),
+            (12, 8)
+        );
+    }
+    // serve follows its file, so it cannot take one from stdin: a message, exit 2.
+    let serve = raystep_with_input(dir.path(), &["serve", "-", "--port", "0"], &seed);
+    assert_eq!(serve.status.code(), Some(2));
+    assert!(
+        text(&serve.stderr).contains("cannot take one from standard input"),
+        "{}",
+        text(&serve.stderr)
+    );
+}
+
+#[test]
+fn no_help_shows_rustdoc_syntax() {
+    let dir = tempfile::tempdir().unwrap();
+    let commands: &[&[&str]] = &[
+        &[],
+        &["stages"],
+        &["render"],
+        &["explain"],
+        &["check"],
+        &["diff"],
+        &["figures"],
+        &["accuracy"],
+        &["bench"],
+        &["generate"],
+        &["generate", "spheres"],
+        &["chart"],
+        &["serve"],
+        &["completions"],
+        &["man"],
+    ];
+    for command in commands {
+        for help in ["--help", "-h"] {
+            let mut args = command.to_vec();
+            args.push(help);
+            let out = raystep(dir.path(), &args);
+            assert!(out.status.success(), "{args:?}");
+            let said = text(&out.stdout);
+            assert!(said.contains("Usage"), "{args:?}");
+            for rustdoc in ["[`", "`]", "](", "crate::"] {
+                assert!(
+                    !said.contains(rustdoc),
+                    "{args:?} shows {rustdoc:?}:\n{said}"
+                );
+            }
+        }
+    }
+    // The number --accel's help states is the one the code uses.
+    let help = text(&raystep(dir.path(), &["render", "--help"]).stdout);
+    let from = format!("A BVH from {} spheres on", raystep::accel::BVH_FROM);
+    assert!(help.contains(&from), "{help}");
 }

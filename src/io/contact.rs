@@ -77,6 +77,8 @@ pub const THUMBNAIL_WIDTH: u32 = 320;
 pub struct ContactSheet {
     max_width: u32,
     rows: Vec<Row>,
+    /// How the colour pictures are encoded (`--png`), as in their own files.
+    png: crate::io::output::PngEncoding,
 }
 
 /// Where everything goes, in pixels.
@@ -112,7 +114,14 @@ impl ContactSheet {
         ContactSheet {
             max_width: max_width.max(1),
             rows: Vec::new(),
+            png: crate::io::output::PngEncoding::Linear,
         }
+    }
+
+    /// The same, its colour pictures encoded as `png` says, as their PNG files are.
+    pub fn with_png(mut self, png: crate::io::output::PngEncoding) -> ContactSheet {
+        self.png = png;
+        self
     }
 
     /// Add a row labelled `label` (e.g. "1 rays") from `frame`: for each column, the
@@ -127,7 +136,7 @@ impl ContactSheet {
             let picture = RgbImage::from_raw(
                 frame.width,
                 frame.height,
-                crate::io::output::visualise(frame, buffer),
+                crate::io::output::visualise_as(frame, buffer, self.png),
             )
             .expect("visualise gives 3 bytes per pixel");
             Some(if (width, height) == (frame.width, frame.height) {

@@ -86,9 +86,10 @@ pub fn pixels_js(folder: &str, frame: &Frame) -> String {
         "raystepPixels.load({folder}, {{\"width\": {}, \"height\": {}, \"fields\": {fields}, \"data\": \"",
         frame.width, frame.height
     ));
-    // Three pixels are 132 bytes, a multiple of 3: encoded three pixels at a time,
-    // the base64 is the same as the whole at once, without holding all the bytes.
-    const GROUP: usize = 3 * FIELDS.len() * 4;
+    // Three pixels are 132 bytes, a multiple of 3: encoded 3 × 256 pixels at a
+    // time, the base64 is the same as the whole at once, without holding all the
+    // bytes.
+    const GROUP: usize = 256 * 3 * FIELDS.len() * 4;
     let mut group = Vec::with_capacity(GROUP);
     for row in 0..frame.height {
         for col in 0..frame.width {
@@ -106,22 +107,11 @@ pub fn pixels_js(folder: &str, frame: &Frame) -> String {
     js
 }
 
-/// Append the base64 of `bytes` to `out` (RFC 4648, with `=` padding).
+/// Append the base64 of `bytes` to `out` (RFC 4648, with `=` padding), by the
+/// `base64` crate.
 fn base64_into(out: &mut String, bytes: &[u8]) {
-    const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    for chunk in bytes.chunks(3) {
-        // Three bytes (zeros past the end) are 24 bits: four digits of 6 bits.
-        let byte = |i: usize| u32::from(chunk.get(i).copied().unwrap_or(0));
-        let bits = byte(0) << 16 | byte(1) << 8 | byte(2);
-        for digit in 0..4 {
-            if digit <= chunk.len() {
-                let index = (bits >> (18 - 6 * digit)) & 63;
-                out.push(char::from(ALPHABET[index as usize]));
-            } else {
-                out.push('=');
-            }
-        }
-    }
+    use base64::Engine as _;
+    base64::engine::general_purpose::STANDARD.encode_string(bytes, out);
 }
 
 /// The page: `scene_name` at `width` × `height`, a row per stage.

@@ -69,26 +69,48 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
     load_sized(path, SizeOverride::default())
 }
 
-/// Read and check the scene file at `path`, at the size `size` asks for.
+/// The name of the scene read from standard input (the path `-`) in messages.
+pub const STDIN_NAME: &str = "<stdin>";
+
+/// Whether `path` is `-`, the scene read from standard input.
+pub fn is_stdin(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// The name of the scene at `path` in messages: the path, or [`STDIN_NAME`] for `-`.
+pub fn display_name(path: &Path) -> String {
+    if is_stdin(path) {
+        STDIN_NAME.to_string()
+    } else {
+        path.display().to_string()
+    }
+}
+
+/// Read and check the scene file at `path` (`-`: standard input), at the size
+/// `size` asks for.
 pub fn load_sized(path: &Path, size: SizeOverride) -> Result<Scene, Error> {
-    let file = path.display().to_string();
+    let file = display_name(path);
     let fail = |message: String| Error::Scene {
         file: file.clone(),
         message,
     };
     let cannot = |e: std::io::Error| fail(format!("cannot read the scene file: {e}"));
-    let meta = std::fs::metadata(path).map_err(cannot)?;
-    if meta.is_dir() {
-        return Err(fail(
-            "is a folder; give the path of a .toml scene file".into(),
-        ));
-    }
-    // Read at most one byte past the limit: a device such as /dev/zero has no
-    // length to check beforehand.
+    let reader: Box<dyn std::io::Read> = if is_stdin(path) {
+        Box::new(std::io::stdin().lock())
+    } else {
+        let meta = std::fs::metadata(path).map_err(cannot)?;
+        if meta.is_dir() {
+            return Err(fail(
+                "is a folder; give the path of a .toml scene file".into(),
+            ));
+        }
+        Box::new(std::fs::File::open(path).map_err(cannot)?)
+    };
+    // Read at most one byte past the limit: a device such as /dev/zero (or a
+    // pipe) has no length to check beforehand.
     let mut bytes = Vec::new();
-    let file_handle = std::fs::File::open(path).map_err(cannot)?;
     std::io::Read::read_to_end(
-        &mut std::io::Read::take(file_handle, MAX_FILE_BYTES + 1),
+        &mut std::io::Read::take(reader, MAX_FILE_BYTES + 1),
         &mut bytes,
     )
     .map_err(cannot)?;

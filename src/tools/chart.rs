@@ -16,7 +16,6 @@
 //! size, rendered with `--accel auto` and with the plain loop (`--accel off`, up to
 //! the count where it becomes too slow to wait for).
 
-use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
@@ -229,30 +228,44 @@ pub fn mark_frontier(points: &mut [Point]) {
 
 /// The points as CSV.
 pub fn csv(points: &[Point]) -> String {
-    let mut out = String::from("setting,median_ms,rmse_levels,worst_levels,default,frontier\n");
-    for p in points {
-        let _ = writeln!(
-            out,
-            "{},{:.3},{:.4},{:.2},{},{}",
-            csv_field(&p.label),
-            p.median_s * 1e3,
-            p.rmse,
-            p.worst,
-            p.default,
-            p.frontier
-        );
-    }
-    out
+    csv_text(
+        &[
+            "setting",
+            "median_ms",
+            "rmse_levels",
+            "worst_levels",
+            "default",
+            "frontier",
+        ],
+        points.iter().map(|p| {
+            [
+                p.label.clone(),
+                format!("{:.3}", p.median_s * 1e3),
+                format!("{:.4}", p.rmse),
+                format!("{:.2}", p.worst),
+                p.default.to_string(),
+                p.frontier.to_string(),
+            ]
+        }),
+    )
 }
 
-/// `text` as one CSV field: quoted (and its quotes doubled) where it holds a
-/// comma, a quote or a line break, as RFC 4180 has it ("spp 4, f32" is a label).
-fn csv_field(text: &str) -> std::borrow::Cow<'_, str> {
-    if text.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", text.replace('"', "\"\"")).into()
-    } else {
-        text.into()
+/// A header and rows as CSV, one record a line ending in `\n`, a field quoted
+/// (its quotes doubled) only where it holds a comma, a quote or a line break, as
+/// RFC 4180 has it ("spp 4, f32" is a label). Written by the `csv` crate.
+fn csv_text<const N: usize>(header: &[&str; N], rows: impl Iterator<Item = [String; N]>) -> String {
+    let mut writer = csv::WriterBuilder::new()
+        .terminator(csv::Terminator::Any(b'\n'))
+        .from_writer(Vec::new());
+    let fail = "writing CSV into memory cannot fail";
+    writer.write_record(header).expect(fail);
+    for row in rows {
+        writer.write_record(&row).expect(fail);
     }
+    let bytes = writer
+        .into_inner()
+        .expect("flushing CSV into memory cannot fail");
+    String::from_utf8(bytes).expect("CSV of strings is UTF-8")
 }
 
 /// One measurement of the scale sweep.
@@ -321,19 +334,18 @@ pub fn scale(
 
 /// The scale points as CSV.
 pub fn scale_csv(points: &[ScalePoint]) -> String {
-    let mut out = String::from("spheres,accel,median_ms,bvh_build_ms,bvh_bytes\n");
-    for p in points {
-        let _ = writeln!(
-            out,
-            "{},{},{:.3},{:.3},{}",
-            p.count,
-            p.accel,
-            p.median_s * 1e3,
-            p.build_s * 1e3,
-            p.bvh_bytes
-        );
-    }
-    out
+    csv_text(
+        &["spheres", "accel", "median_ms", "bvh_build_ms", "bvh_bytes"],
+        points.iter().map(|p| {
+            [
+                p.count.to_string(),
+                p.accel.to_string(),
+                format!("{:.3}", p.median_s * 1e3),
+                format!("{:.3}", p.build_s * 1e3),
+                p.bvh_bytes.to_string(),
+            ]
+        }),
+    )
 }
 
 /// Make the built-in font the charts' "sans-serif" (once).
@@ -648,7 +660,8 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines[1], "\"spp 4, f32\",10.000,1.0000,1.00,false,false");
         assert_eq!(lines[2], "default,5.000,2.0000,2.00,false,false");
-        assert_eq!(csv_field("a \"b\""), "\"a \"\"b\"\"\"");
+        let quoted = csv_text(&["a"], [["a \"b\"".to_string()]].into_iter());
+        assert_eq!(quoted, "a\n\"a \"\"b\"\"\"\n");
     }
 
     #[test]

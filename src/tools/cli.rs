@@ -3,14 +3,14 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, CommandFactory, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::accel::Accel;
 use crate::aov::Frame;
 use crate::engine::render;
 use crate::error::Error;
-use crate::io::output::Pending;
+use crate::io::output::{Pending, PngEncoding};
 use crate::io::scene_file::{self, check_max_depth, SizeOverride};
 use crate::real::Precision;
 use crate::render::Settings;
@@ -26,6 +26,59 @@ macro_rules! say {
     ($($arg:tt)*) => {
         say_line(format_args!($($arg)*))?
     };
+}
+
+/// Print a status line on standard error (what is being done, what was written),
+/// unless `-q/--quiet` was given. Standard output is for what a command produces.
+macro_rules! status {
+    ($($arg:tt)*) => {
+        status_line(format_args!($($arg)*))
+    };
+}
+
+/// Set by `-q/--quiet`: no status lines and no progress bar.
+static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+fn quiet() -> bool {
+    QUIET.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Write a status line to standard error, unless quiet. A status line that
+/// cannot be written is not an error: the work it reports on is done.
+fn status_line(text: std::fmt::Arguments) {
+    use std::io::Write;
+    if !quiet() {
+        let _ = writeln!(std::io::stderr().lock(), "{text}");
+    }
+}
+
+/// The version of every JSON object raystep prints (`"schema": 1`): it grows when
+/// a field changes meaning or goes away, not when a field is added.
+pub const JSON_SCHEMA: u32 = 1;
+
+/// `value` (an object) with `"schema": 1` added, as JSON text (keys in
+/// alphabetical order).
+pub fn json_text(value: &impl serde::Serialize, pretty: bool) -> String {
+    let mut object = serde_json::Map::new();
+    object.insert("schema".into(), JSON_SCHEMA.into());
+    match serde_json::to_value(value).expect("plain data serialises") {
+        serde_json::Value::Object(fields) => object.extend(fields),
+        other => {
+            object.insert("data".into(), other);
+        }
+    }
+    let object = serde_json::Value::Object(object);
+    if pretty {
+        serde_json::to_string_pretty(&object)
+    } else {
+        serde_json::to_string(&object)
+    }
+    .expect("plain data serialises")
+}
+
+/// Print `value` (an object) as JSON on standard output, with `"schema": 1`.
+fn say_json(value: serde_json::Value, pretty: bool) -> Result<(), Error> {
+    say_line(format_args!("{}", json_text(&value, pretty)))
 }
 
 /// Write `text` and a newline to standard output. A closed pipe (`raystep ... |
@@ -74,6 +127,10 @@ pub struct Cli {
     /// What to do (default: `stages` on the built-in scene).
     #[command(subcommand)]
     pub command: Option<Command>,
+    /// Print no status lines (what is being rendered, the files written, the
+    /// progress bar) on standard error; errors and warnings still go there.
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
 }
 
 /// The limits that keep a mistake from taking the machine down, as `--help` prints
@@ -90,8 +147,9 @@ Limits (a value beyond them is refused with a message, exit code 2):
   generate       at most 100,000 spheres
   chart --scale  a --max-count whose largest scene fits in 2.1 GB: about 750
                  bytes per sphere and 64 per pixel
-Exit codes: 0 done, 2 a mistake in the input, 130 interrupted (Ctrl-C: the files
-of the render before stay as they were).";
+Exit codes: 0 done, 1 diff found the images different, 2 a mistake in the input
+or trouble, 130 interrupted (Ctrl-C: the files of the render before stay as they
+were).";
 
 /// The subcommands.
 #[derive(Subcommand, Debug)]
@@ -127,6 +185,15 @@ pub enum Command {
     /// pixel's story, re-rendered on demand; the scene file is watched. Also an
     /// HTTP API (see the README). Runs until Ctrl-C.
     Serve(crate::tools::serve::ServeArgs),
+    /// Print a completion script for a shell to standard output, e.g.
+    /// raystep completions bash > ~/.local/share/bash-completion/completions/raystep
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Print the manual page (roff) to standard output, e.g. raystep man | man -l -
+    Man,
 }
 
 /// Arguments of `raystep explain`.
@@ -170,7 +237,7 @@ pub struct ChartArgs {
     #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..=10_000_000))]
     pub max_count: u64,
     /// Where the CSV and the charts go.
-    #[arg(long, default_value = "out")]
+    #[arg(long, short = 'o', visible_alias = "output", default_value = "out")]
     pub out: PathBuf,
 }
 
@@ -231,8 +298,8 @@ pub struct AccuracyArgs {
 /// The scene to render and its size.
 #[derive(Args, Debug, Default)]
 pub struct SceneArgs {
-    /// Scene file (TOML, at most 16 MiB). Default: the built-in figure-1 scene
-    /// (scenes/seed.toml).
+    /// Scene file (TOML, at most 16 MiB; - reads it from standard input). Default:
+    /// the built-in figure-1 scene (scenes/seed.toml).
     pub scene: Option<PathBuf>,
     /// Image width in pixels (overrides the scene's [image] width; 1 to 16384, and
     /// at most 7680 × 4320 pixels in all: about 64 bytes of memory each).
@@ -317,8 +384,14 @@ pub struct StagesArgs {
     #[allow(missing_docs)]
     pub rules: RuleArgs,
     /// Output folder; each stage goes into a numbered folder inside it.
-    #[arg(long, default_value = "out")]
+    #[arg(long, short = 'o', visible_alias = "output", default_value = "out")]
     pub out: PathBuf,
+    /// How beauty.png and the Blinn-Phong terms' pictures store their linear
+    /// values: as they are (the tutorial's; they look dark in a viewer), or
+    /// through the sRGB transfer function, with an sRGB chunk. buffers.exr is
+    /// always linear.
+    #[arg(long, value_enum, value_name = "srgb|linear", default_value_t = PngEncoding::Linear)]
+    pub png: PngEncoding,
 }
 
 /// One frame to render: the scene, the stages and the rules (`render`, `bench`).
@@ -345,15 +418,28 @@ pub struct RenderArgs {
     #[allow(missing_docs)]
     pub frame: FrameArgs,
     /// Output folder.
-    #[arg(long, default_value = "out")]
+    #[arg(long, short = 'o', visible_alias = "output", default_value = "out")]
     pub out: PathBuf,
+    /// How beauty.png and the Blinn-Phong terms' pictures store their linear
+    /// values: as they are (the tutorial's; they look dark in a viewer), or
+    /// through the sRGB transfer function, with an sRGB chunk. buffers.exr is
+    /// always linear.
+    #[arg(long, value_enum, value_name = "srgb|linear", default_value_t = PngEncoding::Linear)]
+    pub png: PngEncoding,
+    /// Print one JSON object on standard output saying what was written: the
+    /// files and their sizes, the buffers, the timings and the rays traced.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `raystep check`.
 #[derive(Args, Debug)]
 pub struct CheckArgs {
-    /// Scene file (TOML) to check.
+    /// Scene file (TOML) to check; - reads it from standard input.
     pub scene: PathBuf,
+    /// Print one JSON object instead of the report in words.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `raystep diff`.
@@ -363,13 +449,48 @@ pub struct DiffArgs {
     pub a: PathBuf,
     /// The second render's buffers.exr.
     pub b: PathBuf,
+    /// The tolerance of one channel, as idiff's -fail: a pixel differs when some
+    /// channel of its beauty (linear, 1 = white) differs by more than this. The
+    /// default is one 8-bit step, 1/255.
+    #[arg(long, default_value_t = 1.0 / 255.0, value_parser = parse_threshold)]
+    pub threshold: f32,
+    /// The percentage of pixels that may differ before the images count as
+    /// different, as idiff's -failpercent (0 to 100).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_percent)]
+    pub fail_percent: f64,
+    /// Print one JSON object instead of the report in words.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// A channel tolerance: a finite number, 0 or more.
+fn parse_threshold(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(t) if t.is_finite() && t >= 0.0 => Ok(t),
+        _ => Err(format!(
+            "`{text}`: expected a tolerance of one channel, a number 0 or more such as 0.004"
+        )),
+    }
+}
+
+/// A percentage from 0 to 100.
+fn parse_percent(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(p) if (0.0..=100.0).contains(&p) => Ok(p),
+        _ => Err(format!("`{text}`: expected a percentage from 0 to 100")),
+    }
 }
 
 /// Arguments of `raystep figures`.
 #[derive(Args, Debug)]
 pub struct FiguresArgs {
     /// Where the images go.
-    #[arg(long, default_value = "chapters/img")]
+    #[arg(
+        long,
+        short = 'o',
+        visible_alias = "output",
+        default_value = "chapters/img"
+    )]
     pub out: PathBuf,
     /// Re-render and compare with the images in --out instead of writing them.
     #[arg(long)]
@@ -378,23 +499,44 @@ pub struct FiguresArgs {
 
 /// Carry out a parsed command line.
 pub fn run(cli: Cli) -> Result<(), Error> {
+    execute(cli).map(|_| ())
+}
+
+/// The exit code of `raystep diff` for images that differ beyond the threshold
+/// (as diff, cmp and idiff: 0 the same, 1 different, 2 trouble).
+pub const DIFFERENT: u8 = 1;
+
+/// Carry out a parsed command line and return the exit code of a command done:
+/// 0, or [`DIFFERENT`] for a `diff` of images that differ.
+pub fn execute(cli: Cli) -> Result<u8, Error> {
+    QUIET.store(cli.quiet, std::sync::atomic::Ordering::Relaxed);
     // The commands that render start their threads first, so that a machine that
     // cannot give them (RAYON_NUM_THREADS=200 under a memory limit) gets a message
     // instead of a panic inside rayon. bench builds its own pools, with the same
     // care; check, diff and generate need none.
     if !matches!(
         cli.command,
-        Some(Command::Check(_) | Command::Diff(_) | Command::Generate(_) | Command::Bench(_))
+        Some(
+            Command::Check(_)
+                | Command::Diff(_)
+                | Command::Generate(_)
+                | Command::Bench(_)
+                | Command::Completions { .. }
+                | Command::Man
+        )
     ) {
         start_threads()?;
+    }
+    if let Some(Command::Diff(args)) = &cli.command {
+        return diff(args);
     }
     match cli.command {
         None => stages(StagesArgs::default_out()),
         Some(Command::Stages(args)) => stages(args),
         Some(Command::Render(args)) => render_one(args),
         Some(Command::Explain(args)) => explain(&args),
-        Some(Command::Check(args)) => check(&args.scene),
-        Some(Command::Diff(args)) => diff(&args),
+        Some(Command::Check(args)) => check(&args),
+        Some(Command::Diff(_)) => unreachable!("diff returns its own exit code above"),
         Some(Command::Figures(args)) => figures(&args),
         Some(Command::Accuracy(args)) => accuracy(&args),
         Some(Command::Bench(args)) => bench(args),
@@ -406,7 +548,23 @@ pub fn run(cli: Cli) -> Result<(), Error> {
                 write_stdout(text.as_bytes())
             }
         },
+        Some(Command::Completions { shell }) => {
+            let mut text = Vec::new();
+            clap_complete::generate(shell, &mut Cli::command(), "raystep", &mut text);
+            write_stdout(&text)
+        }
+        Some(Command::Man) => {
+            let mut text = Vec::new();
+            clap_mangen::Man::new(Cli::command())
+                .render(&mut text)
+                .map_err(|e| Error::Output {
+                    path: "the manual page".into(),
+                    message: e.to_string(),
+                })?;
+            write_stdout(&text)
+        }
     }
+    .map(|()| 0)
 }
 
 impl StagesArgs {
@@ -415,6 +573,7 @@ impl StagesArgs {
             scene: SceneArgs::default(),
             rules: RuleArgs::default(),
             out: PathBuf::from("out"),
+            png: PngEncoding::Linear,
         }
     }
 }
@@ -469,7 +628,7 @@ impl SceneArgs {
 
 fn scene_name(args: &SceneArgs) -> String {
     match &args.scene {
-        Some(path) => path.display().to_string(),
+        Some(path) => scene_file::display_name(path),
         None => scene_file::SEED_NAME.to_string(),
     }
 }
@@ -506,7 +665,7 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
     let base = args.rules.apply(&mut scene, Stages::ALL)?;
     // Every file of every stage is renamed into place at the end, together: an
     // error or Ctrl-C on the way leaves the folder as it was.
-    let mut pending = Pending::new();
+    let mut pending = Pending::new().with_png(args.png);
     pending.folder(&args.out)?;
     // The stage folders are raystep's own names: a link or a file at one is
     // refused now, before anything is rendered.
@@ -516,18 +675,19 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
         let stages = Stages::up_to(stage);
         crate::io::output::check_final_names(&crate::io::output::frame_files(&dir, stages))?;
     }
-    say!(
+    status!(
         "{name}: every stage at {} × {}, {} engine",
         scene.width,
         scene.height,
         base.engine
     );
-    let bar = progress_bar(u64::from(scene.height) * Stage::ALL.len() as u64);
+    let bar = job_bar(u64::from(scene.height) * Stage::ALL.len() as u64, "rows");
     let start = Instant::now();
     let mut page = Vec::new(); // a row of index.html per stage
-    let mut sheet = crate::io::contact::ContactSheet::new(crate::io::contact::THUMBNAIL_WIDTH);
+    let mut sheet = crate::io::contact::ContactSheet::new(crate::io::contact::THUMBNAIL_WIDTH)
+        .with_png(args.png);
     for stage in Stage::ALL {
-        bar.set_message(stage.folder());
+        bar.set_message(format!("rendering {}", stage.folder()));
         let dir = args.out.join(stage.folder());
         let settings = Settings {
             stages: Stages::up_to(stage),
@@ -553,7 +713,7 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
         // One frame at a time: at 1920 × 1080 a frame is about 100 MB.
         drop(frame);
     }
-    bar.finish_and_clear();
+    bar.set_message("writing the page");
     let contact = args.out.join(CONTACT_SHEET);
     pending.file(&contact, &sheet.png())?;
     let index = crate::io::page::write_index(
@@ -565,13 +725,14 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
         &page,
     )?;
     pending.commit()?;
-    say!(
+    bar.finish_and_clear();
+    status!(
         "wrote {} stages into {}/ in {:.2} s",
         Stage::ALL.len(),
         args.out.display(),
         start.elapsed().as_secs_f64()
     );
-    say!(
+    status!(
         "open {} to look through every stage and buffer ({} has them on one sheet)",
         index.display(),
         contact.display()
@@ -585,8 +746,7 @@ fn explain(args: &ExplainArgs) -> Result<(), Error> {
     check_pixel(&scene, x, y)?;
     let story = crate::tools::explain::explain(&scene, &settings, x, y);
     if args.json {
-        let json = serde_json::to_string_pretty(&story).expect("an explanation is plain data");
-        say!("{json}");
+        say!("{}", json_text(&story, true));
     } else {
         say!(
             "{}: {} × {}",
@@ -614,51 +774,95 @@ pub fn check_pixel(scene: &Scene, x: u32, y: u32) -> Result<(), Error> {
 }
 
 fn render_one(args: RenderArgs) -> Result<(), Error> {
+    let start = Instant::now();
     let (scene, settings) = prepare(&args.frame)?;
-    let mut pending = Pending::new();
+    let mut pending = Pending::new().with_png(args.png);
     pending.folder(&args.out)?;
     crate::io::output::check_final_names(&crate::io::output::frame_files(
         &args.out,
         settings.stages,
     ))?;
     let name = scene_name(&args.frame.scene);
-    say!(
+    status!(
         "{name}: {} at {} × {}, {} engine",
         settings.stages,
         scene.width,
         scene.height,
         settings.engine
     );
-    let bar = progress_bar(u64::from(scene.height));
+    let bar = job_bar(u64::from(scene.height), "rows");
+    bar.set_message("rendering");
     let (frame, seconds) = timed(|| render(&scene, &settings, &|n| bar.inc(n)));
-    bar.finish_and_clear();
     crate::error::check_interrupt()?;
-    write(&mut pending, &frame, &args.out, seconds, &bar)?;
-    pending.commit()
+    let (written, write_seconds) = write(&mut pending, &frame, &args.out, seconds, &bar)?;
+    bar.finish_and_clear();
+    pending.commit()?;
+    if args.json {
+        let files: Vec<serde_json::Value> = written
+            .iter()
+            .map(|path| {
+                let bytes = std::fs::metadata(path).map(|m| m.len()).ok();
+                serde_json::json!({ "path": path.display().to_string(), "bytes": bytes })
+            })
+            .collect();
+        let buffers: Vec<&str> = frame.buffers().map(|b| b.name()).collect();
+        say_json(
+            serde_json::json!({
+                "scene": name,
+                "width": scene.width,
+                "height": scene.height,
+                "stages": settings.stages.to_string(),
+                "engine": settings.engine.to_string(),
+                "precision": settings.precision.to_string(),
+                "spp": settings.spp,
+                "out": args.out.display().to_string(),
+                "files": files,
+                "buffers": buffers,
+                "seconds": {
+                    "render": seconds,
+                    "write": write_seconds,
+                    "total": start.elapsed().as_secs_f64(),
+                },
+                "rays": {
+                    "primary": frame.rays.primary,
+                    "shadow": frame.rays.shadow,
+                    "reflection": frame.rays.reflection,
+                    "total": frame.rays.total(),
+                },
+            }),
+            true,
+        )?;
+    }
+    Ok(())
 }
 
-/// Write the files of `frame` into `pending` and say which, with the times.
+/// Write the files of `frame` into `pending` (the bar's phase: writing files) and
+/// say which, with the times; the paths written and the seconds it took.
 fn write(
     pending: &mut Pending,
     frame: &Frame,
     dir: &Path,
     render_seconds: f64,
     bar: &ProgressBar,
-) -> Result<(), Error> {
+) -> Result<(Vec<PathBuf>, f64), Error> {
+    let phase = bar.message().replace("rendering", "writing files");
+    bar.set_message(phase);
     let (written, write_seconds) = timed(|| pending.frame(frame, dir));
-    let names: Vec<String> = written?
+    let written = written?;
+    let names: Vec<String> = written
         .iter()
         .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
         .collect();
     bar.suspend(|| {
-        say_line(format_args!(
+        status!(
             "  {:<28} {}   render {:.3} s, write {:.3} s",
             format!("{}/", dir.display()),
             names.join(" "),
             render_seconds,
             write_seconds
-        ))
-    })
+        );
+    });
+    Ok((written, write_seconds))
 }
 
 fn bench(mut args: BenchArgs) -> Result<(), Error> {
@@ -676,15 +880,14 @@ fn bench(mut args: BenchArgs) -> Result<(), Error> {
         yardstick: !args.no_yardstick,
     };
     if !args.json {
-        say!("{name}: {}", settings.stages);
+        status!("{name}: {}", settings.stages);
     }
     let bar = counted_bar(u64::from(args.runs) + 1, "bench", "runs");
     let report = crate::tools::bench::bench(&scene, &settings, options, &|n| bar.inc(n))?;
     bar.finish_and_clear();
     crate::error::check_interrupt()?;
     if args.json {
-        let json = serde_json::to_string(&report).expect("a report is always valid JSON");
-        say!("{json}");
+        say!("{}", json_text(&report, false));
     } else {
         say!("{}", report.text().trim_end());
     }
@@ -722,7 +925,7 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
             .iter()
             .map(|&n| if n <= plain_up_to { 2 } else { 1 } * (args.runs as u64 + 1))
             .sum();
-        say!(
+        status!(
             "time against spheres at {} × {}: {} counts",
             size.0,
             size.1,
@@ -739,12 +942,12 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
             crate::tools::chart::write_scale(&mut pending, &args.out, "scale", &points, &title)?;
         pending.commit()?;
         say!("{}", csv.trim_end());
-        say!("wrote {}/scale.csv, {}", args.out.display(), names(&files));
+        status!("wrote {}/scale.csv, {}", args.out.display(), names(&files));
         return Ok(());
     }
     args.scene.default_size(960, 540);
     let (scene, name) = load_scene(&args.scene)?;
-    say!(
+    status!(
         "{name}: speed against accuracy at {} × {}",
         scene.width,
         scene.height
@@ -763,7 +966,7 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
         crate::tools::chart::write_sweep(&mut pending, &args.out, "chart", &points, &title)?;
     pending.commit()?;
     say!("{}", csv.trim_end());
-    say!("wrote {}/chart.csv, {}", args.out.display(), names(&files));
+    status!("wrote {}/chart.csv, {}", args.out.display(), names(&files));
     Ok(())
 }
 
@@ -781,19 +984,36 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
     (value, start.elapsed().as_secs_f64())
 }
 
-/// A bar of rows on stderr, drawn only when stderr is a terminal.
-fn progress_bar(rows: u64) -> ProgressBar {
-    counted_bar(rows, "{msg:>16}", "rows")
+/// One bar on stderr for a whole job of `len` `unit`s, its phase named in the
+/// message ("rendering", "writing files"); ticking on its own, so that a long
+/// write does not look stalled.
+fn job_bar(len: u64, unit: &str) -> ProgressBar {
+    let bar = counted_bar(len, "{msg:<24}", unit);
+    bar.enable_steady_tick(std::time::Duration::from_millis(250));
+    bar
 }
 
 /// A bar on stderr counting `len` `unit`s after `label`, drawn only when stderr is
-/// a terminal.
+/// a terminal and not `--quiet`. The time left shows only once 5 % is done and
+/// half a second has passed: a first guess from the first rows is far off.
 fn counted_bar(len: u64, label: &str, unit: &str) -> ProgressBar {
-    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    let template = format!("{label} [{{bar:30}}] {{pos}}/{{len}} {unit}, {{eta}} left");
+    let target = if quiet() {
+        ProgressDrawTarget::hidden()
+    } else {
+        ProgressDrawTarget::stderr()
+    };
+    let bar = ProgressBar::with_draw_target(Some(len), target);
+    let template = format!("{label} [{{bar:30}}] {{pos}}/{{len}} {unit}, {{elapsed}}{{left}}");
+    let left = |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+        let done = state.fraction();
+        if (0.05..1.0).contains(&done) && state.elapsed().as_secs_f64() >= 0.5 {
+            let _ = write!(w, ", {:#} left", indicatif::HumanDuration(state.eta()));
+        }
+    };
     bar.set_style(
         ProgressStyle::with_template(&template)
             .expect("the template is valid")
+            .with_key("left", left)
             .progress_chars("=> "),
     );
     bar
@@ -826,7 +1046,7 @@ fn check_scale_memory(spheres: usize, (width, height): (u32, u32)) -> Result<(),
     Ok(())
 }
 
-fn diff(args: &DiffArgs) -> Result<(), Error> {
+fn diff(args: &DiffArgs) -> Result<u8, Error> {
     let (wa, ha, a) = crate::tools::compare::read_beauty(&args.a)?;
     let (wb, hb, b) = crate::tools::compare::read_beauty(&args.b)?;
     if (wa, ha) != (wb, hb) {
@@ -837,6 +1057,34 @@ fn diff(args: &DiffArgs) -> Result<(), Error> {
         )));
     }
     let d = crate::tools::compare::compare(&a, &b, wa);
+    let over = crate::tools::compare::pixels_over(&a, &b, args.threshold);
+    let percent = 100.0 * over as f64 / d.pixels.max(1) as f64;
+    let different = percent > args.fail_percent;
+    let code = if different { DIFFERENT } else { 0 };
+    if args.json {
+        say_json(
+            serde_json::json!({
+                "a": args.a.display().to_string(),
+                "b": args.b.display().to_string(),
+                "width": wa,
+                "height": ha,
+                "pixels": d.pixels,
+                "threshold": args.threshold,
+                "fail_percent": args.fail_percent,
+                "over_threshold": over,
+                "over_threshold_percent": percent,
+                "over_one_step": d.over_one_step,
+                "largest": finite_or_null(f64::from(d.largest)),
+                "largest_at": { "row": d.largest_at.0, "column": d.largest_at.1 },
+                "rmse": d.rmse,
+                "clipped": [d.saturated.0, d.saturated.1],
+                "non_finite": [d.non_finite.0, d.non_finite.1],
+                "different": different,
+            }),
+            true,
+        )?;
+        return Ok(code);
+    }
     say!(
         "{} against {}: {wa} × {ha} pixels",
         args.a.display(),
@@ -867,7 +1115,24 @@ fn diff(args: &DiffArgs) -> Result<(), Error> {
             d.non_finite.1
         );
     }
-    Ok(())
+    say!(
+        "  {}: {over} pixels ({percent:.2} %) differ by more than {:.6} (--threshold), {} \
+         {:.2} % (--fail-percent)",
+        if different { "different" } else { "the same" },
+        args.threshold,
+        if different { "more than" } else { "at most" },
+        args.fail_percent
+    );
+    Ok(code)
+}
+
+/// `x` as a JSON number, or null where it is infinite or NaN (which JSON lacks).
+fn finite_or_null(x: f64) -> serde_json::Value {
+    if x.is_finite() {
+        x.into()
+    } else {
+        serde_json::Value::Null
+    }
 }
 
 fn accuracy(args: &AccuracyArgs) -> Result<(), Error> {
@@ -886,6 +1151,11 @@ fn accuracy(args: &AccuracyArgs) -> Result<(), Error> {
         None => measure_all(),
     };
     if args.json {
+        // An array, as before: each row carries the schema.
+        let rows: Vec<serde_json::Value> = rows
+            .iter()
+            .map(|row| serde_json::from_str(&json_text(row, false)).expect("valid JSON"))
+            .collect();
         say!(
             "{}",
             serde_json::to_string_pretty(&rows).expect("plain data serialises")
@@ -917,7 +1187,7 @@ fn figures(args: &FiguresArgs) -> Result<(), Error> {
         )));
     }
     let written = crate::tools::figures::write_all(root, &args.out, &render_command)?;
-    say!(
+    status!(
         "wrote {} figures into {}/",
         written.len(),
         args.out.display()
@@ -925,14 +1195,82 @@ fn figures(args: &FiguresArgs) -> Result<(), Error> {
     Ok(())
 }
 
-fn check(path: &Path) -> Result<(), Error> {
+fn check(args: &CheckArgs) -> Result<(), Error> {
+    let path = &args.scene;
+    let name = scene_file::display_name(path);
     let scene = scene_file::load(path)?;
-    warn_if_empty(&scene, &path.display().to_string());
-    say!(
-        "{}",
-        describe(&scene, &path.display().to_string()).trim_end()
-    );
+    warn_if_empty(&scene, &name);
+    if args.json {
+        return say_json(describe_json(&scene, &name), true);
+    }
+    say!("{}", describe(&scene, &name).trim_end());
     Ok(())
+}
+
+/// A checked scene as `raystep check --json` prints it (without `"schema"`).
+pub fn describe_json(scene: &Scene, name: &str) -> serde_json::Value {
+    use serde_json::json;
+    let v = |v: crate::Vec3| json!([v.x, v.y, v.z]);
+    let s = scene.camera().screen;
+    let objects: Vec<serde_json::Value> = scene
+        .objects
+        .iter()
+        .map(|o| {
+            let m = &o.material;
+            let material = json!({
+                "ambient": v(m.ambient),
+                "diffuse": v(m.diffuse),
+                "specular": v(m.specular),
+                "shininess": m.shininess,
+                "reflection": m.reflection,
+            });
+            let entry = match o.role {
+                Role::Sphere => "sphere",
+                Role::Floor => "plane",
+            };
+            match o.shape {
+                Shape::Sphere(sp) => json!({
+                    "entry": entry,
+                    "shape": "sphere",
+                    "center": v(sp.center),
+                    "radius": sp.radius,
+                    "material": material,
+                }),
+                Shape::Plane(p) => json!({
+                    "entry": entry,
+                    "shape": "plane",
+                    "point": v(p.point),
+                    "normal": v(p.normal),
+                    "material": material,
+                }),
+            }
+        })
+        .collect();
+    let l = &scene.light;
+    json!({
+        "scene": name,
+        "valid": true,
+        "width": scene.width,
+        "height": scene.height,
+        "max_depth": scene.max_depth,
+        "camera": v(scene.camera),
+        "screen": {
+            "left": s.left,
+            "right": s.right,
+            "top": s.top,
+            "bottom": s.bottom,
+            "from_scene": scene.screen.is_some(),
+        },
+        "light": {
+            "position": v(l.position),
+            "ambient": v(l.ambient),
+            "diffuse": v(l.diffuse),
+            "specular": v(l.specular),
+        },
+        "spheres": scene.objects.iter().filter(|o| o.role == Role::Sphere).count(),
+        "planes": scene.objects.iter().filter(|o| o.role == Role::Floor).count(),
+        "objects": objects,
+    })
 }
 
 /// A readable summary of a checked scene, as `raystep check` prints it.

@@ -74,6 +74,17 @@ pub fn compare(a: &[[f32; 3]], b: &[[f32; 3]], width: usize) -> Difference {
     d
 }
 
+/// Pixels of two images of one size where some channel differs by more than
+/// `tolerance` (a channel finite in one image and not in the other differs by
+/// more than any tolerance): what `raystep diff --threshold` counts.
+pub fn pixels_over(a: &[[f32; 3]], b: &[[f32; 3]], tolerance: f32) -> usize {
+    assert_eq!(a.len(), b.len(), "images of one size");
+    a.iter()
+        .zip(b)
+        .filter(|(p, q)| (0..3).any(|c| channel_difference(p[c], q[c]) > tolerance))
+        .count()
+}
+
 /// The beauty (`R`, `G`, `B`) of a `buffers.exr` file: width, height, pixels.
 ///
 /// The header is read first, and an image larger than raystep renders is refused

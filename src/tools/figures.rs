@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use crate::aov::{Buffer, Frame};
 use crate::error::Error;
+use crate::io::output::{png_bytes_as, PngEncoding};
 
 /// What renders a figure: the frame of `raystep ARGS` with scene paths relative to
 /// `ROOT` (the command line's [`render_command`](crate::tools::cli::render_command),
@@ -50,6 +51,7 @@ pub const FIGURES: &[Figure] = &[
     fig("ch07/true", "render scenes/true-plane.toml --stage plane", &[Beauty, Depth, Normal, Shadow]),
     fig("ch08/camera", "render --tutorial --out out/camera", &[Beauty]),
     fig("ch08/ray-origin", "render --tutorial --viewer ray-origin --out out/ray-origin", &[Beauty]),
+    fig("ch08/srgb", "render scenes/seed.toml --png srgb --out out/srgb", &[Beauty]),
     fig("ch09/far-naive", "render scenes/stress/far-sphere.toml --precision f32 --intersect naive", &[Beauty]),
     fig("ch09/far-stable", "render scenes/stress/far-sphere.toml --precision f32", &[Beauty]),
     fig("ch09/graze-naive", "render scenes/stress/graze.toml --precision f32 --intersect naive", &[Beauty]),
@@ -129,8 +131,18 @@ impl Figure {
         Ok(self
             .buffers
             .iter()
-            .map(|&b| (self.file(b), crate::io::output::png_bytes(&frame, b)))
+            .map(|&b| (self.file(b), png_bytes_as(&frame, b, self.png())))
             .collect())
+    }
+
+    /// The `--png` of its command (linear without one).
+    pub fn png(&self) -> PngEncoding {
+        let words: Vec<&str> = self.args.split_whitespace().collect();
+        words
+            .windows(2)
+            .find(|w| w[0] == "--png")
+            .and_then(|w| clap::ValueEnum::from_str(w[1], false).ok())
+            .unwrap_or_default()
     }
 }
 

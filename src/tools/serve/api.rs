@@ -209,6 +209,13 @@ impl Studio {
     /// Serve the scene file at `path` (or the built-in scene): refused, with the
     /// command line's message, if it does not load now.
     pub fn open(path: Option<&Path>) -> Result<Studio, Error> {
+        if path.is_some_and(scene_file::is_stdin) {
+            return Err(Error::Usage(
+                "serve watches its scene file and reloads it on every change, so it \
+                 cannot take one from standard input (-): give the path of a file"
+                    .into(),
+            ));
+        }
         let (source, name) = match path {
             None => (Source::BuiltIn, scene_file::SEED_NAME.to_string()),
             Some(p) => (Source::File(p.to_path_buf()), p.display().to_string()),
@@ -295,6 +302,13 @@ impl Studio {
         {
             let mut served = self.lock();
             if now.is_some() && now == served.stamp {
+                served.settling = None;
+                return false;
+            }
+            // An empty file is one being written (truncated, its bytes not yet
+            // there: on a busy machine that can outlast two looks); no scene is
+            // empty, so wait for its bytes rather than report it broken.
+            if now.as_ref().is_some_and(|s| s.len == 0) {
                 served.settling = None;
                 return false;
             }
@@ -441,8 +455,7 @@ impl Studio {
         let (x, y) = args.pixel;
         check_pixel(&scene, x, y)?;
         let story = crate::tools::explain::explain(&scene, &settings, x, y);
-        let json = serde_json::to_string_pretty(&story).expect("an explanation is plain data");
-        Ok(json + "\n")
+        Ok(crate::tools::cli::json_text(&story, true) + "\n")
     }
 
     /// `GET /api/scene`: the version, the error of the latest reload (or null),
