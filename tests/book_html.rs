@@ -15,6 +15,8 @@
 //! (`apt-get install chromium`), Node.js and `npm ci --prefix tests/browser`.
 //! Without them the tests are skipped, or fail under CI (where `CI` is set).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -72,47 +74,6 @@ fn book_tools() -> Result<PathBuf, String> {
         Ok(bin)
     } else {
         Err(missing.join("; "))
-    }
-}
-
-/// Chromium and Node.js with playwright-core, or what is missing.
-fn browser_tools() -> Result<PathBuf, String> {
-    let chromium = std::env::var_os("CHROMIUM")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
-    let mut missing = Vec::new();
-    if !chromium.is_file() {
-        missing.push(format!(
-            "Chromium at {} (apt-get install chromium, or set CHROMIUM to its path)",
-            chromium.display()
-        ));
-    }
-    let node = Command::new("node").arg("--version").output();
-    if !node.is_ok_and(|o| o.status.success()) {
-        missing.push("Node.js (apt-get install nodejs npm)".to_string());
-    }
-    if !root()
-        .join("tests/browser/node_modules/playwright-core")
-        .is_dir()
-    {
-        missing.push("playwright-core (npm ci --prefix tests/browser)".to_string());
-    }
-    if missing.is_empty() {
-        Ok(chromium)
-    } else {
-        Err(missing.join("; "))
-    }
-}
-
-/// The tools, or `None` when the test is to be skipped (it panics under CI).
-fn required<T>(tools: Result<T, String>, what: &str) -> Option<T> {
-    match tools {
-        Ok(tools) => Some(tools),
-        Err(missing) if std::env::var_os("CI").is_some() => panic!("{what} needs: {missing}"),
-        Err(missing) => {
-            eprintln!("skipped: {what} needs: {missing}");
-            None
-        }
     }
 }
 
@@ -272,7 +233,7 @@ fn remote_loads(html: &str) -> Vec<String> {
 #[test]
 fn the_built_book_typesets_its_maths_keeps_listings_at_the_margin_and_loads_nothing_from_elsewhere()
 {
-    let Some(bin) = required(book_tools(), "the book test") else {
+    let Some(bin) = common::required(book_tools(), "the book test") else {
         return;
     };
     let book = build(&bin);
@@ -374,10 +335,11 @@ fn walk(dir: &Path) -> Vec<PathBuf> {
 
 #[test]
 fn every_page_of_the_built_book_renders_offline_in_chromium() {
-    let Some(bin) = required(book_tools(), "the browser test of the book") else {
+    let Some(bin) = common::required(book_tools(), "the browser test of the book") else {
         return;
     };
-    let Some(chromium) = required(browser_tools(), "the browser test of the book") else {
+    let Some(chromium) = common::required(common::browser_tools(), "the browser test of the book")
+    else {
         return;
     };
     let book = build(&bin);

@@ -7,6 +7,8 @@
 //! `npm ci --prefix tests/browser`. Without them the test is skipped, or fails
 //! under CI (where `CI` is set).
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -33,33 +35,6 @@ const FIELDS: [(&str, &str); 11] = [
 
 fn manifest_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// Chromium and Node.js with playwright-core, or what is missing.
-fn browser_tools() -> Result<PathBuf, String> {
-    let chromium = std::env::var_os("CHROMIUM")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
-    let mut missing = Vec::new();
-    if !chromium.is_file() {
-        missing.push(format!(
-            "Chromium at {} (apt-get install chromium, or set CHROMIUM to its path)",
-            chromium.display()
-        ));
-    }
-    let node = Command::new("node").arg("--version").output();
-    if !node.is_ok_and(|o| o.status.success()) {
-        missing.push("Node.js (apt-get install nodejs npm)".to_string());
-    }
-    let playwright = manifest_dir().join("tests/browser/node_modules/playwright-core");
-    if !playwright.is_dir() {
-        missing.push("playwright-core (npm ci --prefix tests/browser)".to_string());
-    }
-    if missing.is_empty() {
-        Ok(chromium)
-    } else {
-        Err(missing.join("; "))
-    }
 }
 
 /// Every channel of a `buffers.exr` file, by name.
@@ -112,15 +87,8 @@ fn js_number(text: &str) -> f64 {
 
 #[test]
 fn the_page_shows_the_exact_numbers_of_the_pixel_under_the_mouse() {
-    let chromium = match browser_tools() {
-        Ok(chromium) => chromium,
-        Err(missing) if std::env::var_os("CI").is_some() => {
-            panic!("the browser test needs: {missing}")
-        }
-        Err(missing) => {
-            eprintln!("skipped: the browser test needs: {missing}");
-            return;
-        }
+    let Some(chromium) = common::required(common::browser_tools(), "the browser test") else {
+        return;
     };
 
     // The built-in scene, every stage, with the page.

@@ -5,6 +5,8 @@
 //! that try to leave the page, bad options), a load of 1,000 requests from 50
 //! clients, Ctrl-C, and a fuzz of the query parser (in-process).
 
+mod common;
+
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
 use std::path::{Path, PathBuf};
@@ -901,48 +903,13 @@ fn encode(pairs: &[(String, String)]) -> String {
         .join("&")
 }
 
-/// Chromium and Node.js with playwright-core, or what is missing (as
-/// tests/page.rs finds them).
-fn browser_tools() -> Result<PathBuf, String> {
-    let chromium = std::env::var_os("CHROMIUM")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
-    let mut missing = Vec::new();
-    if !chromium.is_file() {
-        missing.push(format!("Chromium at {}", chromium.display()));
-    }
-    let node = Command::new("node").arg("--version").output();
-    if !node.is_ok_and(|o| o.status.success()) {
-        missing.push("Node.js".to_string());
-    }
-    let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    if !manifest
-        .join("tests/browser/node_modules/playwright-core")
-        .is_dir()
-    {
-        missing.push("playwright-core (npm ci --prefix tests/browser)".to_string());
-    }
-    if missing.is_empty() {
-        Ok(chromium)
-    } else {
-        Err(missing.join("; "))
-    }
-}
-
 /// The page in a real headless Chromium (`tests/browser/studio.mjs`): stages
 /// switched, a refusal shown with the command line's reason, a buffer picked, a
 /// pixel's story read (exactly `explain --json`), and a saved scene followed.
 #[test]
 fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_file() {
-    let chromium = match browser_tools() {
-        Ok(chromium) => chromium,
-        Err(missing) if std::env::var_os("CI").is_some() => {
-            panic!("the browser test needs: {missing}")
-        }
-        Err(missing) => {
-            eprintln!("skipped: the browser test needs: {missing}");
-            return;
-        }
+    let Some(chromium) = common::required(common::browser_tools(), "the browser test") else {
+        return;
     };
     let (dir, scene) = scene_folder();
     let new_scene = dir.path().join("new.toml");

@@ -66,3 +66,46 @@ pub fn raystep(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
         .output()
         .expect("the binary runs")
 }
+
+/// Chromium and Node.js with playwright-core, as the browser tests drive them
+/// (`tests/browser/`), or what is missing.
+pub fn browser_tools() -> Result<std::path::PathBuf, String> {
+    use std::path::PathBuf;
+    let chromium = std::env::var_os("CHROMIUM")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
+    let mut missing = Vec::new();
+    if !chromium.is_file() {
+        missing.push(format!(
+            "Chromium at {} (apt-get install chromium, or set CHROMIUM to its path)",
+            chromium.display()
+        ));
+    }
+    let node = std::process::Command::new("node").arg("--version").output();
+    if !node.is_ok_and(|o| o.status.success()) {
+        missing.push("Node.js (apt-get install nodejs npm)".to_string());
+    }
+    let playwright = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/browser/node_modules/playwright-core");
+    if !playwright.is_dir() {
+        missing.push("playwright-core (npm ci --prefix tests/browser)".to_string());
+    }
+    if missing.is_empty() {
+        Ok(chromium)
+    } else {
+        Err(missing.join("; "))
+    }
+}
+
+/// The tools a test needs, or `None` when it is to be skipped: with a message
+/// locally, and a failure under CI, where they are installed.
+pub fn required<T>(tools: Result<T, String>, what: &str) -> Option<T> {
+    match tools {
+        Ok(tools) => Some(tools),
+        Err(missing) if std::env::var_os("CI").is_some() => panic!("{what} needs: {missing}"),
+        Err(missing) => {
+            eprintln!("skipped: {what} needs: {missing}");
+            None
+        }
+    }
+}
