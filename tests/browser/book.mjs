@@ -15,7 +15,7 @@
 
 import path from "node:path";
 import { pathToFileURL } from "node:url";
-import { chromium } from "playwright-core";
+import { launch, watch } from "./chromium.mjs";
 
 function parseArguments(argv) {
   const options = { chromium: "/usr/bin/chromium", size: "1280x900", pages: [] };
@@ -66,17 +66,8 @@ function measureMaths() {
 async function visit(context, options, name) {
   const report = { page: name, console: [], pageErrors: [], failedRequests: [], blocked: [], badResponses: [], requests: 0 };
   const page = await context.newPage();
-  page.on("console", (message) => {
-    if (["error", "warning", "warn"].includes(message.type())) {
-      report.console.push({ type: message.type(), text: message.text() });
-    }
-  });
-  page.on("pageerror", (error) => report.pageErrors.push(String(error)));
-  page.on("requestfailed", (request) => {
-    if (!report.blocked.includes(request.url())) {
-      report.failedRequests.push({ url: request.url(), error: request.failure()?.errorText });
-    }
-  });
+  // A request blocked for leaving the machine is noted in `blocked` instead.
+  watch(page, report, (request) => report.blocked.includes(request.url()));
   page.on("response", (response) => {
     if (response.status() >= 400) {
       report.badResponses.push({ url: response.url(), status: response.status() });
@@ -108,20 +99,7 @@ async function visit(context, options, name) {
 
 async function main() {
   const options = parseArguments(process.argv.slice(2));
-  // Playwright starts the browser with a fresh profile in a temporary folder.
-  const browser = await chromium.launch({
-    executablePath: options.chromium,
-    headless: true,
-    args: [
-      "--no-sandbox",
-      "--disable-gpu",
-      "--disable-quic",
-      "--no-first-run",
-      "--disable-background-networking",
-      "--disable-component-update",
-      "--disable-sync",
-    ],
-  });
+  const browser = await launch(options.chromium);
   const pages = [];
   try {
     const context = await browser.newContext({ viewport: options.viewport, deviceScaleFactor: 1 });

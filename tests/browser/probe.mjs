@@ -12,7 +12,7 @@
 // The screenshot is taken after the last probe.
 
 import { pathToFileURL } from "node:url";
-import { chromium } from "playwright-core";
+import { launch, watch } from "./chromium.mjs";
 
 function parseArguments(argv) {
   const options = { chromium: "/usr/bin/chromium", size: "1400x1000", probes: [] };
@@ -72,33 +72,12 @@ async function probe(page, { stage, buffer, x, y }) {
 
 async function main() {
   const options = parseArguments(process.argv.slice(2));
-  // Playwright starts the browser with a fresh profile in a temporary folder.
-  const browser = await chromium.launch({
-    executablePath: options.chromium,
-    headless: true,
-    args: [
-      "--no-sandbox",
-      "--disable-gpu",
-      "--disable-quic",
-      "--no-first-run",
-      "--disable-background-networking",
-      "--disable-component-update",
-      "--disable-sync",
-    ],
-  });
+  const browser = await launch(options.chromium);
   const report = { console: [], pageErrors: [], failedRequests: [], probes: [] };
   try {
     const context = await browser.newContext({ viewport: options.viewport, deviceScaleFactor: 1 });
     const page = await context.newPage();
-    page.on("console", (message) => {
-      if (["error", "warning", "warn"].includes(message.type())) {
-        report.console.push({ type: message.type(), text: message.text() });
-      }
-    });
-    page.on("pageerror", (error) => report.pageErrors.push(String(error)));
-    page.on("requestfailed", (request) =>
-      report.failedRequests.push({ url: request.url(), error: request.failure()?.errorText }),
-    );
+    watch(page, report);
     await page.goto(pathToFileURL(options.page).href, { waitUntil: "load" });
     for (const p of options.probes) {
       report.probes.push(await probe(page, p));

@@ -13,7 +13,7 @@
 //    refusal, story: {x, y, json}, version, screenshot}
 
 import { copyFileSync } from "node:fs";
-import { chromium } from "playwright-core";
+import { launch, watch } from "./chromium.mjs";
 
 function parseArguments(argv) {
   const options = { chromium: "/usr/bin/chromium", size: "1400x1000" };
@@ -39,35 +39,14 @@ async function settled(page, state) {
 
 async function main() {
   const options = parseArguments(process.argv.slice(2));
-  const browser = await chromium.launch({
-    executablePath: options.chromium,
-    headless: true,
-    args: [
-      "--no-sandbox",
-      "--disable-gpu",
-      "--disable-quic",
-      "--no-first-run",
-      "--disable-background-networking",
-      "--disable-component-update",
-      "--disable-sync",
-    ],
-  });
+  const browser = await launch(options.chromium);
   const report = { console: [], pageErrors: [], failedRequests: [], steps: [] };
   try {
     const context = await browser.newContext({ viewport: options.viewport, deviceScaleFactor: 1 });
     const page = await context.newPage();
-    page.on("console", (message) => {
-      if (["error", "warning", "warn"].includes(message.type())) {
-        report.console.push({ type: message.type(), text: message.text() });
-      }
-    });
-    page.on("pageerror", (error) => report.pageErrors.push(String(error)));
-    page.on("requestfailed", (request) => {
-      // A render that a newer one supersedes is aborted by the page on purpose,
-      // and the event stream ends when the browser closes.
-      const error = request.failure()?.errorText;
-      if (error !== "net::ERR_ABORTED") report.failedRequests.push({ url: request.url(), error });
-    });
+    // A render that a newer one supersedes is aborted by the page on purpose,
+    // and the event stream ends when the browser closes.
+    watch(page, report, (_request, error) => error === "net::ERR_ABORTED");
     await page.goto(options.url, { waitUntil: "load" });
     report.steps.push({ action: "load", ...(await settled(page, "ready")) });
 
