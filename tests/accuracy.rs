@@ -6,14 +6,13 @@ mod common;
 
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
-use raystep::ray::Ray;
-use raystep::real::{Precision, Real, Vector};
+use raystep::real::{Precision, Real};
 use raystep::render::{render, Settings};
-use raystep::scene::{Material, Object, Role, Shape};
+use raystep::scene::{Object, Shape};
 use raystep::shade::shadow::{step_off, Offset};
-use raystep::sphere::{Method, Sphere};
+use raystep::sphere::Method;
 use raystep::stages::Stages;
-use raystep::tools::accuracy::{case, measure, outside_exactly, Measure, CASES};
+use raystep::tools::accuracy::{case, measure, Measure, CASES};
 use raystep::Vec3;
 
 use Method::{Naive, Stable};
@@ -212,94 +211,9 @@ fn the_contact_shadow_is_whole_with_the_auto_offset_and_holed_with_the_fixed_ste
 
 // ---- Property tests: random spheres and rays at scales from 1e-3 to 1e4 ----
 
-fn material() -> Material {
-    Material {
-        ambient: Vec3::splat(0.1),
-        diffuse: Vec3::splat(0.6),
-        specular: Vec3::ONE,
-        shininess: 100.0,
-        reflection: 0.5,
-    }
-}
-
-/// A sphere, and a ray from outside it aimed near its centre, in `T`. After a hit:
-/// is the stepped-off origin strictly outside (checked exactly), and does a ray from
-/// it into the surface meet it, as a shadow ray into a dark side must?
-fn sphere_recast<T: Real>(
-    center: Vec3,
-    radius: f64,
-    origin: Vec3,
-    aim: Vec3,
-) -> Option<(bool, bool)> {
-    let sphere = Object::<f64> {
-        shape: Shape::Sphere(Sphere { center, radius }),
-        material: material(),
-        role: Role::Sphere,
-    };
-    let object = sphere.cast::<T>();
-    let Shape::Sphere(s) = object.shape else {
-        unreachable!()
-    };
-    let ray: Ray<T> = Ray::towards(T::Vec3::of(origin), T::Vec3::of(aim));
-    let t = s.intersect(&ray, Stable)?;
-    let point = ray.at(t);
-    let normal = s.normal_at(point);
-    let shifted = step_off(point, normal, &object, AUTO);
-    let outside = outside_exactly(shifted.to_f64(), s.center.to_f64(), s.radius.to_f64());
-    let into = s
-        .intersect(
-            &Ray {
-                origin: shifted,
-                direction: -normal,
-            },
-            Stable,
-        )
-        .is_some();
-    Some((outside, into))
-}
-
-/// A plane, and a ray that hits it, in `T`. After the hit: does a ray from the
-/// stepped-off origin leaving the face (any direction with d·n > 0) miss the plane,
-/// and one going through it (d·n < 0) meet it? (A plane, unlike a sphere under the
-/// tutorial's rule, can be met again by a ray that starts just behind it.)
-fn plane_recast<T: Real>(
-    point: Vec3,
-    normal: Vec3,
-    origin: Vec3,
-    aim: Vec3,
-    out: Vec3,
-) -> Option<(bool, bool)> {
-    let plane = Object::<f64> {
-        shape: Shape::Plane(raystep::plane::Plane { point, normal }),
-        material: material(),
-        role: Role::Floor,
-    };
-    let object = plane.cast::<T>();
-    let Shape::Plane(pl) = object.shape else {
-        unreachable!()
-    };
-    let ray: Ray<T> = Ray::towards(T::Vec3::of(origin), T::Vec3::of(aim));
-    let t = pl.intersect(&ray)?;
-    let hit = ray.at(t);
-    let face = pl.normal_towards(&ray);
-    let shifted = step_off(hit, face, &object, AUTO);
-    // A direction leaving the face, and its mirror through it.
-    let n = face.to_f64();
-    let leave = (out - n * out.dot(n) + n * (0.05 + out.dot(n).abs())).normalize();
-    let through = leave - n * (2.0 * leave.dot(n));
-    let misses = pl
-        .intersect(&Ray {
-            origin: shifted,
-            direction: T::Vec3::of(leave),
-        })
-        .is_none();
-    let meets = pl
-        .intersect(&Ray {
-            origin: shifted,
-            direction: T::Vec3::of(through),
-        })
-        .is_some();
-    Some((misses, meets))
+/// The book's `step_off` with the `auto` offset, as the render moves a hit point.
+fn auto_step<T: Real>(point: T::Vec3, normal: T::Vec3, surface: &Object<T>) -> T::Vec3 {
+    step_off(point, normal, surface, AUTO)
 }
 
 fn scale() -> impl Strategy<Value = f64> {
@@ -328,9 +242,9 @@ proptest! {
         let aim = center + jitter * radius * 0.5; // |jitter| ≤ √3, so inside
         // In float64 the ray aimed inside always hits; in float32 the aim point
         // itself may round outside a small far sphere, so a miss is allowed there.
-        let f64_result = sphere_recast::<f64>(center, radius, origin, aim);
+        let f64_result = common::sphere_recast::<f64>(center, radius, origin, aim, auto_step);
         prop_assert!(f64_result.is_some(), "f64: a ray aimed inside the sphere misses it");
-        for (precision, result) in [("f64", f64_result), ("f32", sphere_recast::<f32>(center, radius, origin, aim))] {
+        for (precision, result) in [("f64", f64_result), ("f32", common::sphere_recast::<f32>(center, radius, origin, aim, auto_step))] {
             if let Some((outside, into)) = result {
                 prop_assert!(outside, "{precision}: stepped-off origin not outside");
                 prop_assert!(into, "{precision}: a ray into the surface misses it");
@@ -351,8 +265,8 @@ proptest! {
         let origin = point + normal * side * s * (0.1 + from.length()) + (from - normal * from.dot(normal)) * s;
         let target = point + (aim - normal * aim.dot(normal)) * s;
         for (precision, result) in [
-            ("f64", plane_recast::<f64>(point, normal, origin, target, out)),
-            ("f32", plane_recast::<f32>(point, normal, origin, target, out)),
+            ("f64", common::plane_recast::<f64>(point, normal, origin, target, out, auto_step)),
+            ("f32", common::plane_recast::<f32>(point, normal, origin, target, out, auto_step)),
         ] {
             if let Some((misses, meets)) = result {
                 prop_assert!(misses, "{precision}: a ray leaving the plane meets it again");

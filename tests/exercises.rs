@@ -10,6 +10,8 @@
 //! the edit as a switch; a test first proves that, unswitched, the copy renders
 //! every pixel exactly as the book's engine does.
 
+mod common;
+
 use std::path::PathBuf;
 
 use raystep::aov::{FirstHit, Frame, PixelRecord};
@@ -1039,20 +1041,8 @@ fn step_by<T: Real>(point: T::Vec3, normal: T::Vec3, surface: &Object<T>, factor
     on_surface + normal * (T::of(factor) * T::UNIT_ROUNDOFF * scale)
 }
 
-/// The material of the property tests' surfaces (it plays no part).
-fn grey() -> raystep::scene::Material {
-    raystep::scene::Material {
-        ambient: Vec3::splat(0.1),
-        diffuse: Vec3::splat(0.6),
-        specular: Vec3::ONE,
-        shininess: 100.0,
-        reflection: 0.5,
-    }
-}
-
-/// `sphere_recast` of `tests/accuracy.rs` with the step's `factor`: after a hit
-/// from `origin` aimed at `aim`, is the stepped-off origin strictly outside, and
-/// does a ray from it into the surface meet it?
+/// The property of `tests/accuracy.rs` for spheres (`common::sphere_recast`),
+/// with the `auto` step at `factor`.
 fn sphere_recast<T: Real>(
     centre: Vec3,
     radius: f64,
@@ -1060,30 +1050,13 @@ fn sphere_recast<T: Real>(
     aim: Vec3,
     factor: f64,
 ) -> Option<(bool, bool)> {
-    let sphere = Object::<f64> {
-        shape: Shape::Sphere(raystep::sphere::Sphere {
-            center: centre,
-            radius,
-        }),
-        material: grey(),
-        role: raystep::scene::Role::Sphere,
-    };
-    let object = sphere.cast::<T>();
-    let Shape::Sphere(s) = object.shape else {
-        unreachable!()
-    };
-    let ray: Ray<T> = Ray::towards(T::Vec3::of(origin), T::Vec3::of(aim));
-    let point = ray.at(s.intersect(&ray, Method::Stable)?);
-    let normal = s.normal_at(point);
-    let shifted = step_by(point, normal, &object, factor);
-    let (c, r) = (s.center.to_f64(), s.radius.to_f64());
-    let outside = outside_exactly(shifted.to_f64(), c, r);
-    let into = Ray::new(shifted, -normal);
-    Some((outside, s.intersect(&into, Method::Stable).is_some()))
+    common::sphere_recast::<T>(centre, radius, origin, aim, |p, n, o| {
+        step_by(p, n, o, factor)
+    })
 }
 
-/// `plane_recast` of `tests/accuracy.rs` with the step's `factor`: after a hit,
-/// does a ray leaving the face miss the plane, and one going through it meet it?
+/// The property of `tests/accuracy.rs` for planes (`common::plane_recast`), with
+/// the `auto` step at `factor`.
 fn plane_recast<T: Real>(
     point: Vec3,
     normal: Vec3,
@@ -1092,29 +1065,8 @@ fn plane_recast<T: Real>(
     out: Vec3,
     factor: f64,
 ) -> Option<(bool, bool)> {
-    let plane = Object::<f64> {
-        shape: Shape::Plane(raystep::plane::Plane { point, normal }),
-        material: grey(),
-        role: raystep::scene::Role::Floor,
-    };
-    let object = plane.cast::<T>();
-    let Shape::Plane(pl) = object.shape else {
-        unreachable!()
-    };
-    let ray: Ray<T> = Ray::towards(T::Vec3::of(origin), T::Vec3::of(aim));
-    let hit = ray.at(pl.intersect(&ray)?);
-    let face = pl.normal_towards(&ray);
-    let shifted = step_by(hit, face, &object, factor);
-    let n = face.to_f64();
-    let leave = (out - n * out.dot(n) + n * (0.05 + out.dot(n).abs())).normalize();
-    let through = leave - n * (2.0 * leave.dot(n));
-    let misses = pl
-        .intersect(&Ray::new(shifted, T::Vec3::of(leave)))
-        .is_none();
-    let meets = pl
-        .intersect(&Ray::new(shifted, T::Vec3::of(through)))
-        .is_some();
-    Some((misses, meets))
+    let step = |p, n, o: &Object<T>| step_by(p, n, o, factor);
+    common::plane_recast::<T>(point, normal, origin, aim, out, step)
 }
 
 /// A case of `a_stepped_off_origin_is_outside_its_sphere_at_any_scale`, from its
@@ -1257,7 +1209,7 @@ fn chapter_09_exercise_2_a_factor_of_2_fails_both_properties_in_float64() {
                 center: centre,
                 radius,
             }),
-            material: grey(),
+            material: common::grey(),
             role: raystep::scene::Role::Sphere,
         };
         let ray = Ray::towards(origin, aim);

@@ -109,3 +109,86 @@ pub fn required<T>(tools: Result<T, String>, what: &str) -> Option<T> {
         }
     }
 }
+
+/// The material of the property tests' surfaces (it plays no part).
+pub fn grey() -> raystep::scene::Material {
+    raystep::scene::Material {
+        ambient: raystep::Vec3::splat(0.1),
+        diffuse: raystep::Vec3::splat(0.6),
+        specular: raystep::Vec3::ONE,
+        shininess: 100.0,
+        reflection: 0.5,
+    }
+}
+
+/// A sphere, and a ray from outside it aimed near its centre, in `T`. After a hit,
+/// with the point moved off the surface by `step` (the book's `step_off`, or a
+/// variant an exercise tries): is the stepped-off origin strictly outside (checked
+/// exactly), and does a ray from it into the surface meet it, as a shadow ray into
+/// a dark side must?
+pub fn sphere_recast<T: raystep::real::Real>(
+    center: raystep::Vec3,
+    radius: f64,
+    origin: raystep::Vec3,
+    aim: raystep::Vec3,
+    step: impl Fn(T::Vec3, T::Vec3, &raystep::scene::Object<T>) -> T::Vec3,
+) -> Option<(bool, bool)> {
+    use raystep::real::Vector;
+    use raystep::scene::{Object, Role, Shape};
+    use raystep::sphere::Method::Stable;
+    let sphere = Object::<f64> {
+        shape: Shape::Sphere(raystep::sphere::Sphere { center, radius }),
+        material: grey(),
+        role: Role::Sphere,
+    };
+    let object = sphere.cast::<T>();
+    let Shape::Sphere(s) = object.shape else {
+        unreachable!()
+    };
+    let ray = raystep::ray::Ray::<T>::towards(T::Vec3::of(origin), T::Vec3::of(aim));
+    let point = ray.at(s.intersect(&ray, Stable)?);
+    let normal = s.normal_at(point);
+    let shifted = step(point, normal, &object);
+    let (c, r) = (s.center.to_f64(), s.radius.to_f64());
+    let outside = raystep::tools::accuracy::outside_exactly(shifted.to_f64(), c, r);
+    let into = raystep::ray::Ray::new(shifted, -normal);
+    Some((outside, s.intersect(&into, Stable).is_some()))
+}
+
+/// A plane, and a ray that hits it, in `T`. After the hit, with the point moved
+/// off by `step`: does a ray from the stepped-off origin leaving the face (any
+/// direction with d·n > 0, made from `out`) miss the plane, and one going through
+/// it (d·n < 0) meet it? (A plane, unlike a sphere under the tutorial's rule, can
+/// be met again by a ray that starts just behind it.)
+pub fn plane_recast<T: raystep::real::Real>(
+    point: raystep::Vec3,
+    normal: raystep::Vec3,
+    origin: raystep::Vec3,
+    aim: raystep::Vec3,
+    out: raystep::Vec3,
+    step: impl Fn(T::Vec3, T::Vec3, &raystep::scene::Object<T>) -> T::Vec3,
+) -> Option<(bool, bool)> {
+    use raystep::real::Vector;
+    use raystep::scene::{Object, Role, Shape};
+    let plane = Object::<f64> {
+        shape: Shape::Plane(raystep::plane::Plane { point, normal }),
+        material: grey(),
+        role: Role::Floor,
+    };
+    let object = plane.cast::<T>();
+    let Shape::Plane(pl) = object.shape else {
+        unreachable!()
+    };
+    let ray = raystep::ray::Ray::<T>::towards(T::Vec3::of(origin), T::Vec3::of(aim));
+    let hit = ray.at(pl.intersect(&ray)?);
+    let face = pl.normal_towards(&ray);
+    let shifted = step(hit, face, &object);
+    // A direction leaving the face, and its mirror through it.
+    let n = face.to_f64();
+    let leave = (out - n * out.dot(n) + n * (0.05 + out.dot(n).abs())).normalize();
+    let through = leave - n * (2.0 * leave.dot(n));
+    let ray_from = |d: raystep::Vec3| raystep::ray::Ray::new(shifted, T::Vec3::of(d));
+    let misses = pl.intersect(&ray_from(leave)).is_none();
+    let meets = pl.intersect(&ray_from(through)).is_some();
+    Some((misses, meets))
+}
