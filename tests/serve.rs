@@ -355,6 +355,262 @@ fn the_scene_is_json_with_a_version_and_the_page_is_served() {
     assert_eq!(post.status, 405);
 }
 
+/// Run the command line, which must succeed.
+fn raystep_ok(args: &[&str]) -> std::process::Output {
+    let out = raystep(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+#[test]
+fn diff_answers_the_figures_raystep_diff_gives_for_the_two_renders() {
+    let (dir, scene) = scene_folder();
+    let server = Server::start(Some(&scene));
+    let s = scene.to_str().unwrap();
+    // A: every stage; B: without shadows, in float32.
+    let (qa, qb) = (
+        "width=60&height=40",
+        "width=60&height=40&without=shadow&precision=f32",
+    );
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    let size = ["--width", "60", "--height", "40"];
+    let mut args = vec!["render", s, "--out", a.to_str().unwrap()];
+    args.extend_from_slice(&size);
+    raystep_ok(&args);
+    let mut args = vec!["render", s, "--out", b.to_str().unwrap()];
+    args.extend_from_slice(&size);
+    args.extend_from_slice(&["--without", "shadow", "--precision", "f32"]);
+    raystep_ok(&args);
+    let cli = raystep(&[
+        "diff",
+        a.join("buffers.exr").to_str().unwrap(),
+        b.join("buffers.exr").to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(cli.status.code(), Some(1), "different");
+    let cli: Value = serde_json::from_slice(&cli.stdout).unwrap();
+    let encode_side = |q: &str| q.replace('=', "%3D").replace('&', "%26");
+    let reply = server.get(&format!(
+        "/api/diff?a={}&b={}",
+        encode_side(qa),
+        encode_side(qb)
+    ));
+    assert_eq!(
+        reply.status,
+        200,
+        "{}",
+        String::from_utf8_lossy(&reply.body)
+    );
+    let api = reply.json();
+    for key in [
+        "schema",
+        "width",
+        "height",
+        "pixels",
+        "threshold",
+        "fail_percent",
+        "over_threshold",
+        "over_threshold_percent",
+        "over_one_step",
+        "largest",
+        "largest_at",
+        "rmse",
+        "clipped",
+        "non_finite",
+        "different",
+    ] {
+        assert_eq!(api[key], cli[key], "{key}");
+    }
+    assert!(api["over_one_step"].as_u64().unwrap() > 100);
+    assert_eq!(api["a_version"], 1);
+    // A against itself: nothing differs.
+    let same = server
+        .get(&format!("/api/diff?a={0}&b={0}", encode_side(qa)))
+        .json();
+    assert_eq!(same["over_one_step"], 0);
+    assert_eq!(same["rmse"], 0.0);
+    assert_eq!(same["different"], false);
+    // Refusals: two sizes, a side missing, a bad option on one side (named).
+    let sizes = server.get(&format!(
+        "/api/diff?a={}&b=width%3D61%26height%3D40",
+        encode_side(qa)
+    ));
+    assert_eq!(sizes.status, 400);
+    assert_eq!(
+        sizes.error(),
+        "a is 60 × 40 but b is 61 × 40: only renders of one size compare"
+    );
+    let missing = server.get(&format!("/api/diff?a={}", encode_side(qa)));
+    assert_eq!(missing.status, 400);
+    assert!(missing.error().starts_with("give the two renders"));
+    let bad = server.get(&format!("/api/diff?a={}&b=spp%3D3", encode_side(qa)));
+    assert_eq!(bad.status, 400);
+    assert!(bad.error().starts_with("b: "), "{}", bad.error());
+    let stray = server.get("/api/diff?a=&b=&width=3");
+    assert_eq!(stray.status, 400);
+}
+
+#[test]
+fn the_light_and_the_camera_moved_render_and_save_as_the_scene_file_does() {
+    let (dir, scene) = scene_folder();
+    let server = Server::start(Some(&scene));
+    let moved = "light=1.5,4,-2&camera=0.25,-0.1,1";
+    let saved = server.get(&format!("/api/scene.toml?{moved}"));
+    assert_eq!(
+        saved.status,
+        200,
+        "{}",
+        String::from_utf8_lossy(&saved.body)
+    );
+    assert!(saved
+        .header("Content-Disposition")
+        .unwrap()
+        .starts_with("attachment; filename=\"scene-studio.toml\""));
+    let path = dir.path().join("saved.toml");
+    std::fs::write(&path, &saved.body).unwrap();
+    let p = path.to_str().unwrap();
+    // The saved file says what the page changed, and renders as the API did.
+    let check = raystep_ok(&["check", p, "--json"]);
+    let check: Value = serde_json::from_slice(&check.stdout).unwrap();
+    let text = check.to_string();
+    assert!(text.contains("1.5") && text.contains("0.25"), "{text}");
+    let out = dir.path().join("out");
+    raystep_ok(&[
+        "render",
+        p,
+        "--width",
+        "60",
+        "--height",
+        "40",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let reply = server.get(&format!("/api/render?{moved}&width=60&height=40"));
+    assert_eq!(reply.status, 200);
+    assert!(reply.body == std::fs::read(out.join("beauty.png")).unwrap());
+    let unmoved = server.get("/api/render?width=60&height=40");
+    assert!(reply.body != unmoved.body, "the move changes the picture");
+    // The pixel's story too.
+    let cli = raystep_ok(&[
+        "explain", p, "--pixel", "30,20", "--json", "--width", "60", "--height", "40",
+    ]);
+    let story = server.get(&format!("/api/pixel?x=30&y=20&{moved}&width=60&height=40"));
+    assert_eq!(
+        String::from_utf8_lossy(&story.body),
+        String::from_utf8_lossy(&cli.stdout)
+    );
+    // No change: the file's own text, as it is.
+    let plain = server.get("/api/scene.toml");
+    assert_eq!(plain.body, raystep::io::scene_file::SEED_TOML.as_bytes());
+    for bad in [
+        "light=1,2",
+        "light=1,2,nan",
+        "camera=a,b,c",
+        "light=1e9,0,0",
+        "width=3",
+    ] {
+        let reply = server.get(&format!("/api/scene.toml?{bad}"));
+        assert_eq!(reply.status, 400, "{bad}");
+        assert!(!reply.error().is_empty());
+    }
+    assert_eq!(server.get("/api/render?light=1,2").status, 400);
+}
+
+#[test]
+fn a_render_a_newer_request_of_its_view_supersedes_is_cancelled() {
+    let server = Server::start(None);
+    let port = server.port;
+    // A render of minutes (1920 × 1080, 64 samples a pixel, in a debug build).
+    let slow = std::thread::spawn(move || {
+        let started = Instant::now();
+        let reply = exchange(
+            port,
+            &format!(
+                "GET /api/render?view=main&width=1920&height=1080&spp=64 HTTP/1.1\r\n\
+                 Host: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n"
+            ),
+        );
+        (reply, started.elapsed())
+    });
+    // Newer renders of the same view, until the slow one has answered: one of
+    // them comes after it started and supersedes it.
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let mut newer = Vec::new();
+    while !slow.is_finished() {
+        assert!(
+            Instant::now() < deadline,
+            "the slow render is still running"
+        );
+        newer.push(
+            server
+                .get("/api/render?view=main&width=30&height=20")
+                .status,
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let (reply, took) = slow.join().unwrap();
+    assert_eq!(
+        reply.status,
+        409,
+        "{}",
+        String::from_utf8_lossy(&reply.body)
+    );
+    assert_eq!(
+        reply.error(),
+        "cancelled: a newer request of view main superseded this one"
+    );
+    eprintln!("superseded after {took:?}, {} newer requests", newer.len());
+    // The newer ones were answered (the last one at least: nothing came after it).
+    assert_eq!(newer.last(), Some(&200));
+    // Other views, and requests without one, are left alone.
+    assert_eq!(
+        server
+            .get("/api/render?view=other&width=30&height=20")
+            .status,
+        200
+    );
+    assert_eq!(server.get("/api/render?view=a%20b").status, 400);
+}
+
+/// The seam the server cancels through: once the flag is set no row starts,
+/// and the answer is none; never set, the frame is the plain render's.
+#[test]
+fn a_cancelled_render_stops_taking_rows() {
+    use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+    for engine in [raystep::stages::Engine::Book, raystep::stages::Engine::Fast] {
+        let scene = common::seed(64, 400);
+        let mut settings: raystep::render::Settings = raystep::stages::Stages::ALL.into();
+        settings.engine = engine;
+        let cancel = AtomicBool::new(false);
+        let rows = AtomicU64::new(0);
+        let frame = raystep::engine::render_cancellable(
+            &scene,
+            &settings,
+            &|n| {
+                rows.fetch_add(n, Ordering::SeqCst);
+                cancel.store(true, Ordering::SeqCst);
+            },
+            &cancel,
+        );
+        assert!(frame.is_none(), "{engine:?}");
+        // Each thread finishes at most the row it had started.
+        let done = rows.load(Ordering::SeqCst);
+        assert!(
+            done <= rayon::current_num_threads() as u64,
+            "{engine:?}: {done} rows of 400 after the cancel"
+        );
+        let never = AtomicBool::new(false);
+        let whole = raystep::engine::render_cancellable(&scene, &settings, &|_| {}, &never)
+            .expect("finished");
+        let plain = raystep::engine::render(&scene, &settings, &|_| {});
+        assert!(whole.pixels == plain.pixels, "{engine:?}");
+    }
+}
+
 /// The command line's message for `args`, as it prints it on stderr (without
 /// `error: `), and its exit code, which must be 2.
 fn cli_error(args: &[&str]) -> String {
@@ -785,6 +1041,11 @@ fn key() -> impl Strategy<Value = String> {
             "help",
             "version",
             "scene",
+            "view",
+            "light",
+            "camera",
+            "a",
+            "b",
             "",
         ])
         .prop_map(String::from),
@@ -835,6 +1096,11 @@ fn value() -> impl Strategy<Value = String> {
             "%2e%2e",
             "..",
             "/etc/passwd",
+            "main",
+            "1,2,3",
+            "1,2",
+            "1e300,0,0",
+            "width%3D9%26height%3D9",
         ])
         .prop_map(String::from),
         (0u32..100).prop_map(|n| n.to_string()),
@@ -869,6 +1135,21 @@ proptest! {
                 prop_assert_eq!(refusal.status, 400);
                 prop_assert!(!refusal.message.is_empty());
             }
+        }
+        // The page's other queries: a diff's two sides, a scene to save.
+        match studio.diff_jobs(&query) {
+            Ok(jobs) => {
+                prop_assert!(jobs.a.pixels() <= raystep::io::scene_file::MAX_PIXELS);
+                prop_assert_eq!(jobs.a.pixels(), jobs.b.pixels());
+            }
+            Err(refusal) => {
+                prop_assert_eq!(refusal.status, 400);
+                prop_assert!(!refusal.message.is_empty());
+            }
+        }
+        if let Err(refusal) = studio.scene_toml(&query) {
+            prop_assert_eq!(refusal.status, 400);
+            prop_assert!(!refusal.message.is_empty());
         }
         match studio.pixel(&format!("x=1&y=1&{query}")) {
             Ok(json) => {
