@@ -1184,11 +1184,30 @@ fn encode(pairs: &[(String, String)]) -> String {
         .join("&")
 }
 
+/// Where the browser test writes the book's screenshots when asked to make
+/// them (`RAYSTEP_STUDIO_SHOTS=chapters/img/ch13`), with their record.
+const SHOTS_VARIABLE: &str = "RAYSTEP_STUDIO_SHOTS";
+
+/// The command that makes the book's screenshots, as chapter 13 shows it.
+pub const SHOTS_COMMAND: &str =
+    "RAYSTEP_STUDIO_SHOTS=chapters/img/ch13 cargo test --test serve studio_page";
+
+/// FNV-1a, 64 bits: the record's fingerprint of each screenshot's bytes.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
 /// The page in a real headless Chromium (`tests/browser/studio.mjs`): stages
-/// switched, a refusal shown with the command line's reason, a buffer picked, a
-/// pixel's story read (exactly `explain --json`), and a saved scene followed.
+/// switched, a refusal shown with the command line's reason, a buffer picked and
+/// shown in false colour, a pixel's story read (exactly `explain --json`), zoom to
+/// single pixels, A/B with `raystep diff`'s figures, the light dragged and the
+/// scene saved as a file, and a saved scene followed. With
+/// `RAYSTEP_STUDIO_SHOTS=DIR`, its screenshots are kept in DIR for the book,
+/// with a record (`shots.json`) that tests/book.rs checks them against.
 #[test]
-fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_file() {
+fn the_studio_page_zooms_compares_drags_tells_a_pixels_story_and_follows_the_file() {
     let Some(chromium) = common::required(common::browser_tools(), "the browser test") else {
         return;
     };
@@ -1197,9 +1216,20 @@ fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_
     let text = raystep::io::scene_file::SEED_TOML;
     std::fs::write(&new_scene, text.replace("radius = 0.7", "radius = 0.5")).unwrap();
     let server = Server::start(Some(&scene));
-    const VIEWPORT: (u32, u32) = (1400, 1000);
+    const VIEWPORT: (u32, u32) = (1400, 900);
     let (x, y) = (150, 120);
     let screenshot = dir.path().join("studio.png");
+    let book_shots = std::env::var_os(SHOTS_VARIABLE).map(|d| {
+        let d = PathBuf::from(d);
+        match d.is_absolute() {
+            true => d,
+            false => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(d),
+        }
+    });
+    let shots = book_shots
+        .clone()
+        .unwrap_or_else(|| dir.path().join("shots"));
+    let download = dir.path().join("saved.toml");
     // The story the page must tell, before the page changes the scene file.
     let pixel = format!("{x},{y}");
     let explain = Command::new(env!("CARGO_BIN_EXE_raystep"))
@@ -1208,6 +1238,26 @@ fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_
         .args(["--pixel", &pixel, "--json", "--stage", "plane"])
         .output()
         .unwrap();
+    // `raystep diff`'s figures for the A/B the page makes, of the scene as it is
+    // then (the page saves a new one later).
+    let s = scene.to_str().unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    raystep_ok(&["render", s, "--out", a.to_str().unwrap()]);
+    raystep_ok(&[
+        "render",
+        s,
+        "--without",
+        "shadow",
+        "--out",
+        b.to_str().unwrap(),
+    ]);
+    let cli = raystep(&[
+        "diff",
+        a.join("buffers.exr").to_str().unwrap(),
+        b.join("buffers.exr").to_str().unwrap(),
+        "--json",
+    ]);
+    let cli: Value = serde_json::from_slice(&cli.stdout).unwrap();
     let run = Command::new("node")
         .arg(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/browser/studio.mjs"))
         .arg("--url")
@@ -1218,6 +1268,10 @@ fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_
         .arg(&scene)
         .arg("--new-scene")
         .arg(&new_scene)
+        .arg("--shots")
+        .arg(&shots)
+        .arg("--download")
+        .arg(&download)
         .arg("--chromium")
         .arg(&chromium)
         .arg("--size")
@@ -1254,6 +1308,11 @@ fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_
             )
         })
         .collect();
+    let light = report["light"]["sent"].as_str().unwrap();
+    let dragged = format!(
+        "stage=plane&light={}&buffer=beauty",
+        light.replace(',', "%2C")
+    );
     assert_eq!(
         queries,
         [
@@ -1264,29 +1323,112 @@ fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_
             ("rays off", "stage=plane&buffer=beauty"),
             ("rays on", "stage=plane&buffer=beauty"),
             ("depth", "stage=plane&buffer=depth"),
+            ("beauty", "stage=plane&buffer=beauty"),
+            ("B: shadow off", "stage=plane&without=shadow&buffer=beauty"),
+            ("shadow on again", "stage=plane&buffer=beauty"),
+            ("light dragged", dragged.as_str()),
+            ("reset", "stage=plane&buffer=beauty"),
+            ("depth again", "stage=plane&buffer=depth"),
             ("scene saved", "stage=plane&buffer=depth"),
         ]
     );
     // The refusal is the command line's.
-    let s = scene.to_str().unwrap();
     let refused = cli_error(&["render", s, "--stage", "plane", "--without", "rays"]);
     assert_eq!(report["refusal"], refused.as_str());
-    // The story is exactly `explain --json`, of the scene as it was then.
+    // False colour: the grey pixels of the depth picture come out coloured.
+    let grey = report["falseColour"]["before"].as_u64().unwrap();
+    assert!(grey > 20_000, "{grey} grey pixels of 60000");
+    assert!(report["falseColour"]["after"].as_u64().unwrap() < grey / 50);
+    // The story is exactly `explain --json`, of the scene as it was then, with
+    // the values of the buffers.
     let story = report["story"]["json"].as_str().unwrap();
     assert!(story == String::from_utf8_lossy(&explain.stdout), "{story}");
     assert!(report["storyText"].as_str().unwrap().contains("Segment 0"));
+    let buffers = report["storyBuffers"].as_str().unwrap();
+    for name in ["beauty", "depth", "normal", "object", "bounces", "rays"] {
+        assert!(buffers.contains(name), "{name} in {buffers}");
+    }
+    // Zoomed in to 32 screen pixels a pixel, a click picks the next pixel.
+    assert!(report["zoom"]["zoom"].as_f64().unwrap() >= 32.0);
+    assert_eq!(report["zoom"]["x"], x + 1);
+    // A/B: nothing differs between A and itself; with B without shadows, the
+    // figures are `raystep diff`'s for the two renders.
+    assert_eq!(report["ab"]["same"]["over_one_step"], 0);
+    assert_eq!(report["ab"]["a"], "stage=plane");
+    assert_eq!(report["ab"]["b"], "stage=plane&without=shadow");
+    let figures = &report["ab"]["figures"];
+    for key in ["over_one_step", "largest", "largest_at", "rmse", "pixels"] {
+        assert_eq!(figures[key], cli[key], "{key}");
+    }
+    let words = report["ab"]["text"].as_str().unwrap();
+    assert!(
+        words.contains(&format!("{} of 60000 pixels", cli["over_one_step"])),
+        "{words}"
+    );
+    // The light moved right only, and the file saved says where it is.
+    let before = report["light"]["before"].as_str().unwrap();
+    assert_eq!(before, "(5, 5, 5)");
+    let moved: Vec<f64> = light.split(',').map(|v| v.parse().unwrap()).collect();
+    assert!(
+        moved[0] > 5.0 && moved[1] == 5.0 && moved[2] == 5.0,
+        "{moved:?}"
+    );
+    assert_eq!(report["saved"]["name"], "scene-studio.toml");
+    let saved = download.to_str().unwrap();
+    raystep_ok(&["check", saved]);
+    let out = dir.path().join("saved");
+    raystep_ok(&["render", saved, "--out", out.to_str().unwrap()]);
+    // The scene file was the built-in scene when it was saved.
+    let api = Server::start(None).get(&format!("/api/render?light={light}"));
+    assert!(api.body == std::fs::read(out.join("beauty.png")).unwrap());
     assert_eq!(report["version"], "2");
 
-    // The screenshot: a PNG of the window's size, not one flat colour; a copy
+    // The screenshots: PNGs of the window's size, not one flat colour; a copy
     // stays in target/ for a person to look at.
-    let bytes = std::fs::read(&screenshot).unwrap();
-    let picture = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
-        .unwrap()
-        .to_rgb8();
-    assert_eq!(picture.dimensions(), VIEWPORT);
-    let colours: std::collections::HashSet<[u8; 3]> = picture.pixels().map(|p| p.0).collect();
-    assert!(colours.len() > 100, "{} colours", colours.len());
+    let mut record = Vec::new();
+    let names = ["overview", "depth-false-colour", "zoom", "ab", "light"];
+    let shot_paths: Vec<PathBuf> = names
+        .iter()
+        .map(|n| shots.join(format!("studio-{n}.png")))
+        .chain([screenshot.clone()])
+        .collect();
+    for path in &shot_paths {
+        let bytes = std::fs::read(path).unwrap();
+        let picture = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+            .unwrap()
+            .to_rgb8();
+        assert_eq!(picture.dimensions(), VIEWPORT, "{}", path.display());
+        let colours: std::collections::HashSet<[u8; 3]> = picture.pixels().map(|p| p.0).collect();
+        assert!(
+            colours.len() > 100,
+            "{}: {} colours",
+            path.display(),
+            colours.len()
+        );
+        record.push(serde_json::json!({
+            "file": path.file_name().unwrap().to_str().unwrap(),
+            "width": VIEWPORT.0,
+            "height": VIEWPORT.1,
+            "bytes": bytes.len(),
+            "fnv1a64": format!("{:016x}", fnv1a(&bytes)),
+        }));
+    }
+    record.pop(); // the last screenshot is not the book's
     let keep = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target");
     std::fs::create_dir_all(&keep).unwrap();
     std::fs::copy(&screenshot, keep.join("studio-screenshot.png")).unwrap();
+    if let Some(book) = book_shots {
+        let manifest = serde_json::json!({
+            "made_by": SHOTS_COMMAND,
+            "note": "screenshots of headless Chromium: not byte-stable from one run to the next, \
+                     so tests/book.rs checks each file against this record, which the test \
+                     writes with them",
+            "shots": record,
+        });
+        std::fs::write(
+            book.join("shots.json"),
+            serde_json::to_string_pretty(&manifest).unwrap() + "\n",
+        )
+        .unwrap();
+    }
 }
