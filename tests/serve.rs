@@ -1185,12 +1185,12 @@ fn encode(pairs: &[(String, String)]) -> String {
 }
 
 /// Where the browser test writes the book's screenshots when asked to make
-/// them (`RAYSTEP_STUDIO_SHOTS=chapters/img/ch13`), with their record.
+/// them (`RAYSTEP_STUDIO_SHOTS=chapters/studio`), with their record.
 const SHOTS_VARIABLE: &str = "RAYSTEP_STUDIO_SHOTS";
 
 /// The command that makes the book's screenshots, as chapter 13 shows it.
 pub const SHOTS_COMMAND: &str =
-    "RAYSTEP_STUDIO_SHOTS=chapters/img/ch13 cargo test --test serve studio_page";
+    "RAYSTEP_STUDIO_SHOTS=chapters/studio cargo test --test serve studio_page";
 
 /// FNV-1a, 64 bits: the record's fingerprint of each screenshot's bytes.
 fn fnv1a(bytes: &[u8]) -> u64 {

@@ -69,6 +69,7 @@ fn clap_message(error: &clap::Error) -> String {
     text.strip_prefix("error: ").unwrap_or(text).to_string()
 }
 
+// ANCHOR: query_words
 /// The words of the command line that `query` stands for (each `--key=value`, or
 /// `--key`), and the values of the keys in `taken`, which the endpoint reads
 /// itself (each at most once), in the order of `taken`.
@@ -125,6 +126,7 @@ pub fn query_words(
     }
     Ok((words, values))
 }
+// ANCHOR_END: query_words
 
 /// Parse `raystep WORDS` with the command line's parser.
 fn parse_command(words: Vec<String>) -> Result<Command, Refusal> {

@@ -201,6 +201,7 @@ struct Claim<'a> {
     cancel: Arc<AtomicBool>,
 }
 
+// ANCHOR: supersede
 impl Views {
     /// Claim `view` for a new request, cancelling the one that had it. No view:
     /// a flag nobody else sets.
@@ -232,6 +233,7 @@ impl Drop for Claim<'_> {
         }
     }
 }
+// ANCHOR_END: supersede
 
 /// A render's place among those in flight, given back when dropped.
 struct Turn<'a> {
