@@ -574,20 +574,6 @@ impl RenderJob {
     pub fn frame(&self, cancel: &AtomicBool) -> Option<Frame> {
         crate::engine::render_cancellable(&self.scene, &self.settings, &|_| {}, cancel)
     }
-
-    /// Render, and encode the buffer as `raystep render` writes its PNG file;
-    /// `None` if `cancel` is set before the render is finished.
-    pub fn run(&self, cancel: &AtomicBool) -> Option<Rendered> {
-        let start = std::time::Instant::now();
-        let frame = self.frame(cancel)?;
-        let render_seconds = start.elapsed().as_secs_f64();
-        let png = crate::io::output::png_bytes_as(&frame, self.buffer, self.png);
-        Some(Rendered {
-            png,
-            render_seconds,
-            encode_seconds: start.elapsed().as_secs_f64() - render_seconds,
-        })
-    }
 }
 
 /// The two renders of `/api/diff`.
