@@ -1313,6 +1313,12 @@ fn the_studio_page_zooms_compares_drags_tells_a_pixels_story_and_follows_the_fil
         "stage=plane&light={}&buffer=beauty",
         light.replace(',', "%2C")
     );
+    let camera = report["camera"]["sent"].as_str().unwrap();
+    let camera_dragged = format!(
+        "stage=plane&light={}&camera={}&buffer=beauty",
+        light.replace(',', "%2C"),
+        camera.replace(',', "%2C")
+    );
     assert_eq!(
         queries,
         [
@@ -1327,6 +1333,7 @@ fn the_studio_page_zooms_compares_drags_tells_a_pixels_story_and_follows_the_fil
             ("B: shadow off", "stage=plane&without=shadow&buffer=beauty"),
             ("shadow on again", "stage=plane&buffer=beauty"),
             ("light dragged", dragged.as_str()),
+            ("camera dragged", camera_dragged.as_str()),
             ("reset", "stage=plane&buffer=beauty"),
             ("depth again", "stage=plane&buffer=depth"),
             ("scene saved", "stage=plane&buffer=depth"),
@@ -1373,6 +1380,14 @@ fn the_studio_page_zooms_compares_drags_tells_a_pixels_story_and_follows_the_fil
         moved[0] > 5.0 && moved[1] == 5.0 && moved[2] == 5.0,
         "{moved:?}"
     );
+    // The camera moved up only (dragged up: +y), and its numbers are shown.
+    let moved: Vec<f64> = camera.split(',').map(|v| v.parse().unwrap()).collect();
+    assert!(
+        moved[0] == 0.0 && moved[1] > 0.0 && moved[2] == 1.0,
+        "{moved:?}"
+    );
+    let shown = report["camera"]["shown"].as_str().unwrap();
+    assert_eq!(shown, format!("(0, {}, 1) moved", moved[1]));
     assert_eq!(report["saved"]["name"], "scene-studio.toml");
     let saved = download.to_str().unwrap();
     raystep_ok(&["check", saved]);

@@ -204,6 +204,18 @@ async function main() {
     const [download] = await Promise.all([page.waitForEvent("download"), page.click("#save-as")]);
     await download.saveAs(options.download);
     report.saved = { file: options.download, name: download.suggestedFilename() };
+    // Drag the camera 40 screen pixels up.
+    await page.check('#drag input[value="camera"]');
+    await page.mouse.move(from.x, from.y);
+    await page.mouse.down();
+    for (let step = 1; step <= 4; step++) await page.mouse.move(from.x, from.y - step * 10);
+    await page.mouse.up();
+    await page.waitForFunction(() => (document.body.dataset.query || "").includes("camera="));
+    report.steps.push({ action: "camera dragged", ...(await settled(page, "ready")) });
+    report.camera = {
+      shown: await page.locator("#camera-position").textContent(),
+      sent: await page.locator("#drag").getAttribute("data-camera"),
+    };
     await page.click("#reset-moves");
     report.steps.push({ action: "reset", ...(await settled(page, "ready")) });
     await page.selectOption("#buffer", "depth");
