@@ -470,6 +470,40 @@ fn the_light_and_the_camera_moved_render_and_save_as_the_scene_file_does() {
         .header("Content-Disposition")
         .unwrap()
         .starts_with("attachment; filename=\"scene-studio.toml\""));
+    // The file's own lines, comments too, with the two positions replaced.
+    let text = String::from_utf8(saved.body.clone()).unwrap();
+    let seed = raystep::io::scene_file::SEED_TOML;
+    let expected = seed
+        .replace("position = [5, 5, 5]", "position = [1.5, 4.0, -2.0]")
+        .replace("position = [0, 0, 1]", "position = [0.25, -0.1, 1.0]");
+    assert_eq!(text, expected);
+    // A scene without the tables gets them, at the end.
+    let bare = raystep::tools::serve::api::Edits {
+        light: Some([1.0, 2.0, 3.0]),
+        camera: None,
+    }
+    .apply(
+        "[[sphere]]\ncenter = [0, 0, -1]\nradius = 0.5\n",
+        "bare.toml",
+    )
+    .unwrap();
+    assert!(
+        bare.ends_with("\n[light]\nposition = [1.0, 2.0, 3.0]\n"),
+        "{bare}"
+    );
+    // A position written over several lines: the text is written again.
+    let spread = raystep::tools::serve::api::Edits {
+        light: Some([1.0, 2.0, 3.0]),
+        camera: None,
+    }
+    .apply(
+        "[light]\nposition = [\n  5,\n  5,\n  5,\n]\n",
+        "spread.toml",
+    )
+    .unwrap();
+    let table: toml::Table = spread.parse().unwrap();
+    assert_eq!(table["light"]["position"].as_array().unwrap().len(), 3);
+    assert_eq!(table["light"]["position"][0].as_float(), Some(1.0));
     let path = dir.path().join("saved.toml");
     std::fs::write(&path, &saved.body).unwrap();
     let p = path.to_str().unwrap();

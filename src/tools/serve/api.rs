@@ -670,8 +670,11 @@ impl Edits {
     }
 
     /// The scene's TOML `text` with the changes made: each position set in its
-    /// table (made if the file has none). The rest of the file stays as it was
-    /// read (comments aside: the text is written again from its values).
+    /// table (made if the file has none). The file's own lines are kept, its
+    /// comments too, with each `position = ...` line replaced ([`Edits::in_place`]);
+    /// when that does not give exactly the values asked for (a position written
+    /// over several lines, an inline table), the text is written again from its
+    /// values, without the comments.
     pub fn apply(&self, text: &str, file: &str) -> Result<String, Error> {
         if self.is_empty() {
             return Ok(text.to_string());
@@ -695,10 +698,62 @@ impl Edits {
             let value = point.iter().map(|&c| toml::Value::Float(c)).collect();
             section.insert("position".into(), toml::Value::Array(value));
         }
+        let kept = self.in_place(text);
+        if kept.parse::<toml::Table>().ok().as_ref() == Some(&table) {
+            return Ok(kept);
+        }
         toml::to_string(&table).map_err(|e| Error::Scene {
             file: file.to_string(),
             message: e.to_string(),
         })
+    }
+
+    /// `text` with each moved position's line replaced, line by line: in the
+    /// table's `position = ...` line (a comment after it kept), or as a new line
+    /// under the table's header, or in a new table at the end. Not checked here:
+    /// [`Edits::apply`] takes it only if it reads as the values asked for.
+    fn in_place(&self, text: &str) -> String {
+        // The name of the table a header line opens (`[light]` -> light); any
+        // line starting with `[` ends the table before it.
+        let header = |line: &str| -> Option<String> {
+            let line = line.trim_start();
+            let inner = line.strip_prefix('[')?.split(']').next()?;
+            Some(inner.trim().to_string())
+        };
+        let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+        for (name, point) in [("light", self.light), ("camera", self.camera)] {
+            let Some([x, y, z]) = point else { continue };
+            let value = format!("position = [{x:?}, {y:?}, {z:?}]");
+            let Some(start) = lines
+                .iter()
+                .position(|l| header(l).as_deref() == Some(name))
+            else {
+                lines.extend([String::new(), format!("[{name}]"), value]);
+                continue;
+            };
+            let end = lines[start + 1..]
+                .iter()
+                .position(|l| header(l).is_some())
+                .map_or(lines.len(), |i| start + 1 + i);
+            let is_position = |l: &String| {
+                let l = l.trim_start();
+                l.strip_prefix("position")
+                    .is_some_and(|rest| rest.trim_start().starts_with('='))
+            };
+            match (start + 1..end).find(|&i| is_position(&lines[i])) {
+                Some(i) => {
+                    let comment = lines[i].find('#').map_or("", |c| &lines[i][c..]);
+                    let comment = if comment.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" {comment}")
+                    };
+                    lines[i] = format!("{value}{comment}");
+                }
+                None => lines.insert(start + 1, value),
+            }
+        }
+        lines.join("\n") + "\n"
     }
 }
 
