@@ -427,13 +427,28 @@ fn diff_answers_the_figures_raystep_diff_gives_for_the_two_renders() {
     }
     assert!(api["over_one_step"].as_u64().unwrap() > 100);
     assert_eq!(api["a_version"], 1);
-    // A against itself: nothing differs.
-    let same = server
-        .get(&format!("/api/diff?a={0}&b={0}", encode_side(qa)))
-        .json();
+    // Both were rendered for it; their beauty is kept for the next.
+    assert_eq!(reply.header("X-Raystep-Renders"), Some("2"));
+    // A against itself: nothing differs, and nothing is rendered again.
+    let same = server.get(&format!("/api/diff?a={0}&b={0}", encode_side(qa)));
+    assert_eq!(same.header("X-Raystep-Renders"), Some("0"));
+    let same = same.json();
     assert_eq!(same["over_one_step"], 0);
     assert_eq!(same["rmse"], 0.0);
     assert_eq!(same["different"], false);
+    // A render the page asked for is kept too: its diff renders only the other.
+    let qc = "width=60&height=40&stage=shadow";
+    assert_eq!(
+        server.get(&format!("/api/render?{qc}&buffer=depth")).status,
+        200
+    );
+    let third = server.get(&format!(
+        "/api/diff?a={}&b={}",
+        encode_side(qc),
+        encode_side("width=60&height=40&tutorial")
+    ));
+    assert_eq!(third.status, 200);
+    assert_eq!(third.header("X-Raystep-Renders"), Some("1"));
     // Refusals: two sizes, a side missing, a bad option on one side (named).
     let sizes = server.get(&format!(
         "/api/diff?a={}&b=width%3D61%26height%3D40",

@@ -418,11 +418,15 @@ impl Studio {
         let name = taken[0].clone().unwrap_or_else(|| "beauty".to_string());
         let view = taken[1].as_deref().map(view_name).transpose()?;
         let edits = Edits::read(&taken[2], &taken[3])?;
+        let said = words.join("\u{1f}");
         let words = std::iter::once("render".to_string()).chain(words).collect();
         let Command::Render(args) = parse_command(words)? else {
             unreachable!("the words begin with `render`")
         };
         let (scene, settings, version) = self.prepare(&args.frame, &edits)?;
+        // A render is a function of the scene's text and these: its beauty can
+        // be looked up by them.
+        let key = format!("{version}\u{1e}{said}\u{1e}{edits:?}");
         let Some(buffer) = Buffer::ALL.into_iter().find(|b| b.name() == name) else {
             let names: Vec<&str> = Buffer::ALL.iter().map(|b| b.name()).collect();
             return Err(Refusal::bad(format!(
@@ -444,6 +448,7 @@ impl Studio {
             png: args.png,
             version,
             view,
+            key,
         })
     }
 
@@ -562,6 +567,9 @@ pub struct RenderJob {
     /// The view it draws (`view=NAME`): a newer render of the same view
     /// supersedes it.
     pub view: Option<String>,
+    /// What the render depends on (the scene's version, the command line's
+    /// words, the moves): two jobs with one key give the same frame.
+    pub key: String,
 }
 
 impl RenderJob {
@@ -586,15 +594,35 @@ pub struct DiffJobs {
     pub view: Option<String>,
 }
 
-/// What `raystep diff --json` reports of two frames' beauty, by its own code
-/// ([`crate::tools::compare`], at its default threshold and fail percent).
-pub fn diff_json(a: &Frame, b: &Frame) -> Value {
+/// A frame's beauty, as `buffers.exr` holds it (its `R`, `G`, `B`).
+pub fn beauty(frame: &Frame) -> Beauty {
+    Beauty {
+        width: frame.width,
+        height: frame.height,
+        pixels: frame.pixels.iter().map(|p| p.colour).collect(),
+    }
+}
+
+/// The beauty of a render: what `raystep diff` compares.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Beauty {
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// Linear RGB, row by row.
+    pub pixels: Vec<[f32; 3]>,
+}
+
+/// What `raystep diff --json` reports of two renders' beauty (of one size), by
+/// its own code ([`crate::tools::compare`], at its default threshold and fail
+/// percent).
+pub fn diff_json(a: &Beauty, b: &Beauty) -> Value {
     use crate::tools::compare::{compare, pixels_over};
-    let beauty = |f: &Frame| -> Vec<[f32; 3]> { f.pixels.iter().map(|p| p.colour).collect() };
-    let (pa, pb) = (beauty(a), beauty(b));
-    let d = compare(&pa, &pb, a.width as usize);
+    let (pa, pb) = (&a.pixels, &b.pixels);
+    let d = compare(pa, pb, a.width as usize);
     let threshold = 1.0f32 / 255.0;
-    let over = pixels_over(&pa, &pb, threshold);
+    let over = pixels_over(pa, pb, threshold);
     let percent = 100.0 * over as f64 / d.pixels.max(1) as f64;
     let largest = f64::from(d.largest);
     json!({

@@ -22,7 +22,7 @@
 
 pub mod api;
 
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::io::Write;
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -110,6 +110,7 @@ pub fn run(args: &ServeArgs) -> Result<(), Error> {
         port,
         gate: Gate::default(),
         views: Views::default(),
+        beauties: Beauties::default(),
         streams: Arc::new(AtomicUsize::new(0)),
         stopping: AtomicBool::new(false),
     });
@@ -176,6 +177,7 @@ struct Shared {
     port: u16,
     gate: Gate,
     views: Views,
+    beauties: Beauties,
     streams: Arc<AtomicUsize>,
     stopping: AtomicBool,
 }
@@ -514,17 +516,62 @@ fn diff(shared: &Shared, request: Request, query: &str) {
         Err(refusal) => return refuse(request, &refusal),
     };
     let claim = shared.views.claim(jobs.view.as_deref());
-    let frames = frame_of(shared, &jobs.a, &claim.cancel)
-        .and_then(|a| frame_of(shared, &jobs.b, &claim.cancel).map(|b| (a, b)));
-    match frames {
-        Ok(((a, _), (b, _))) => {
+    let mut renders = 0;
+    let mut beauty_of = |job: &api::RenderJob| match shared.beauties.get(&job.key) {
+        Some(beauty) => Ok(beauty),
+        None => frame_of(shared, job, &claim.cancel).map(|(frame, _)| {
+            renders += 1;
+            shared.beauties.put(&job.key, api::beauty(&frame))
+        }),
+    };
+    let beauties = beauty_of(&jobs.a).and_then(|a| beauty_of(&jobs.b).map(|b| (a, b)));
+    match beauties {
+        Ok((a, b)) => {
             let mut figures = api::diff_json(&a, &b);
             figures["a_version"] = jobs.a.version.into();
             figures["b_version"] = jobs.b.version.into();
             let body = crate::tools::cli::json_text(&figures, true) + "\n";
-            send(request, 200, JSON, body.into_bytes(), &[])
+            let extra = [("X-Raystep-Renders", renders.to_string())];
+            send(request, 200, JSON, body.into_bytes(), &extra)
         }
         Err(why) => no_frame(request, why, jobs.view.as_deref()),
+    }
+}
+
+/// Pixels of beauty kept for `/api/diff` (12 bytes each: about 100 MB).
+const BEAUTY_PIXELS: u64 = 4 * 1920 * 1080;
+
+/// The beauty of the latest renders, by their [`api::RenderJob::key`]: the page
+/// renders A and B before it asks for their difference, which then needs no
+/// render of its own.
+#[derive(Default)]
+struct Beauties {
+    kept: Mutex<VecDeque<(String, Arc<api::Beauty>)>>,
+}
+
+impl Beauties {
+    fn get(&self, key: &str) -> Option<Arc<api::Beauty>> {
+        let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        kept.iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, b)| Arc::clone(b))
+    }
+
+    /// Keep `beauty` under `key` (the oldest leave to stay within
+    /// [`BEAUTY_PIXELS`]), and give it back.
+    fn put(&self, key: &str, beauty: api::Beauty) -> Arc<api::Beauty> {
+        let beauty = Arc::new(beauty);
+        let size = |b: &api::Beauty| b.pixels.len() as u64;
+        if size(&beauty) > BEAUTY_PIXELS {
+            return beauty;
+        }
+        let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        kept.retain(|(k, _)| k != key);
+        kept.push_back((key.to_string(), Arc::clone(&beauty)));
+        while kept.iter().map(|(_, b)| size(b)).sum::<u64>() > BEAUTY_PIXELS {
+            kept.pop_front();
+        }
+        beauty
     }
 }
 
@@ -540,6 +587,7 @@ fn render(shared: &Shared, request: Request, query: &str) {
         Err(why) => return no_frame(request, why, job.view.as_deref()),
     };
     drop(claim);
+    shared.beauties.put(&job.key, api::beauty(&frame));
     let encoding = Instant::now();
     let png = crate::io::output::png_bytes_as(&frame, job.buffer, job.png);
     let done = api::Rendered {
