@@ -15,6 +15,7 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, SystemTime};
 
 use clap::Parser;
+use rayon::prelude::*;
 use serde_json::{json, Value};
 
 use crate::aov::{Buffer, Frame};
@@ -599,7 +600,7 @@ pub fn beauty(frame: &Frame) -> Beauty {
     Beauty {
         width: frame.width,
         height: frame.height,
-        pixels: frame.pixels.iter().map(|p| p.colour).collect(),
+        pixels: frame.pixels.par_iter().map(|p| p.colour).collect(),
     }
 }
 
