@@ -25,7 +25,15 @@ struct Server {
 impl Server {
     /// Start `raystep serve [scene] --port 0` and read the address it prints.
     fn start(scene: Option<&Path>) -> Server {
+        Server::start_in(None, scene)
+    }
+
+    /// [`Server::start`] in the folder `dir` (a relative `scene` is in it).
+    fn start_in(dir: Option<&Path>, scene: Option<&Path>) -> Server {
         let mut command = Command::new(env!("CARGO_BIN_EXE_raystep"));
+        if let Some(dir) = dir {
+            command.current_dir(dir);
+        }
         command.arg("serve");
         if let Some(scene) = scene {
             command.arg(scene);
@@ -1264,7 +1272,8 @@ fn the_studio_page_zooms_compares_drags_tells_a_pixels_story_and_follows_the_fil
     let new_scene = dir.path().join("new.toml");
     let text = raystep::io::scene_file::SEED_TOML;
     std::fs::write(&new_scene, text.replace("radius = 0.7", "radius = 0.5")).unwrap();
-    let server = Server::start(Some(&scene));
+    // Served by its name in its folder, as a reader would: the page shows it.
+    let server = Server::start_in(Some(dir.path()), Some(Path::new("scene.toml")));
     const VIEWPORT: (u32, u32) = (1400, 900);
     let (x, y) = (150, 120);
     let screenshot = dir.path().join("studio.png");
