@@ -587,7 +587,10 @@ fn render(shared: &Shared, request: Request, query: &str) {
         Err(why) => return no_frame(request, why, job.view.as_deref()),
     };
     drop(claim);
-    shared.beauties.put(&job.key, api::beauty(&frame));
+    // Kept for a diff, unless too large to keep (then not even copied).
+    if job.pixels() <= BEAUTY_PIXELS {
+        shared.beauties.put(&job.key, api::beauty(&frame));
+    }
     let encoding = Instant::now();
     let png = crate::io::output::png_bytes_as(&frame, job.buffer, job.png);
     let done = api::Rendered {
