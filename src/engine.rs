@@ -2,6 +2,8 @@
 //! default) or the fast one ([`crate::fast`]), as `--engine` asks. Both give the
 //! same bits; this is the one place that chooses.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use crate::aov::Frame;
 use crate::render::Settings;
 use crate::scene::Scene;
@@ -23,8 +25,32 @@ pub fn render_into(
     frame: &mut Frame,
     progress: &(dyn Fn(u64) + Sync),
 ) {
+    render_unless(scene, settings, frame, progress, &AtomicBool::new(false));
+}
+
+/// [`render`], unless `cancel` is set before it ends: then no new row is
+/// started and the answer is `None` (the unfinished frame is thrown away).
+/// `raystep serve` sets it when a newer request supersedes the render.
+pub fn render_cancellable(
+    scene: &Scene,
+    settings: &Settings,
+    progress: &(dyn Fn(u64) + Sync),
+    cancel: &AtomicBool,
+) -> Option<Frame> {
+    let mut frame = Frame::blank(scene.camera(), settings.precision);
+    render_unless(scene, settings, &mut frame, progress, cancel);
+    (!cancel.load(Ordering::SeqCst)).then_some(frame)
+}
+
+fn render_unless(
+    scene: &Scene,
+    settings: &Settings,
+    frame: &mut Frame,
+    progress: &(dyn Fn(u64) + Sync),
+    cancel: &AtomicBool,
+) {
     match settings.engine {
-        Engine::Book => crate::render::render_into(scene, settings, frame, progress),
-        Engine::Fast => crate::fast::render_into(scene, settings, frame, progress),
+        Engine::Book => crate::render::render_into(scene, settings, frame, progress, cancel),
+        Engine::Fast => crate::fast::render_into(scene, settings, frame, progress, cancel),
     }
 }

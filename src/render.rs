@@ -7,6 +7,8 @@
 //! Every pixel is computed on its own from the scene alone, so the image is the
 //! same, byte for byte, whatever the number of threads.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use rayon::prelude::*;
 
 use crate::accel::{Accel, BVH_FROM};
@@ -425,22 +427,31 @@ pub fn direction_colour(direction: Vec3) -> Vec3 {
 /// called, from any thread, each time a row is finished.
 pub fn render(scene: &Scene, settings: &Settings, progress: &(dyn Fn(u64) + Sync)) -> Frame {
     let mut frame = Frame::blank(scene.camera(), settings.precision);
-    render_into(scene, settings, &mut frame, progress);
+    render_into(
+        scene,
+        settings,
+        &mut frame,
+        progress,
+        &AtomicBool::new(false),
+    );
     frame
 }
 
 // ANCHOR: render
 /// [`render`] into a frame of the scene's size that is already allocated (as
-/// `raystep bench` does, to time the render alone).
+/// `raystep bench` does, to time the render alone). Once `cancel` is set, no new
+/// row is started and the frame is left unfinished (`raystep serve` cancels a
+/// render that a newer request supersedes).
 pub fn render_into(
     scene: &Scene,
     settings: &Settings,
     frame: &mut Frame,
     progress: &(dyn Fn(u64) + Sync),
+    cancel: &AtomicBool,
 ) {
     match settings.precision {
-        Precision::F32 => render_in::<f32>(scene, settings, frame, progress),
-        Precision::F64 => render_in::<f64>(scene, settings, frame, progress),
+        Precision::F32 => render_in::<f32>(scene, settings, frame, progress, cancel),
+        Precision::F64 => render_in::<f64>(scene, settings, frame, progress, cancel),
     }
 }
 // ANCHOR_END: render
@@ -451,11 +462,12 @@ fn render_in<T: Real>(
     settings: &Settings,
     frame: &mut Frame,
     progress: &(dyn Fn(u64) + Sync),
+    cancel: &AtomicBool,
 ) {
     let tracer = &Tracer::<T>::new(scene, settings);
     let width = tracer.camera.width as usize;
     assert_eq!(frame.pixels.len(), width * tracer.camera.height as usize);
-    let rays = in_rows(frame, width, progress, |row, line| {
+    let rays = in_rows(frame, width, progress, cancel, |row, line| {
         book_row(tracer, settings.spp, row, line)
     });
     frame.describe(scene, tracer, settings, rays);
@@ -464,12 +476,14 @@ fn render_in<T: Real>(
 
 /// The rows of `frame` (`width` pixels each) traced in parallel by `row`, which
 /// fills one row's records and returns the rays they took; `progress(1)` after
-/// each row. After Ctrl-C the rows left are skipped (and the frame is thrown
-/// away). Returns the rays of the whole frame. Both engines render through it.
+/// each row. After Ctrl-C, or once `cancel` is set, the rows left are skipped
+/// (and the frame is thrown away). Returns the rays of the whole frame. Both
+/// engines render through it.
 pub fn in_rows(
     frame: &mut Frame,
     width: usize,
     progress: &(dyn Fn(u64) + Sync),
+    cancel: &AtomicBool,
     row: impl Fn(u32, &mut [PixelRecord]) -> Rays + Sync,
 ) -> Rays {
     frame
@@ -477,7 +491,7 @@ pub fn in_rows(
         .par_chunks_mut(width)
         .enumerate()
         .map(|(r, line)| {
-            if crate::interrupt::requested() {
+            if crate::interrupt::requested() || cancel.load(Ordering::Relaxed) {
                 return Rays::default();
             }
             let rays = row(r as u32, line);

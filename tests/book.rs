@@ -56,7 +56,7 @@ fn includes(text: &str) -> Vec<(String, Option<String>)> {
 const APPENDIX: &str = "tutorial-rules.md";
 
 /// The numbered chapters.
-const CHAPTERS: usize = 12;
+const CHAPTERS: usize = 13;
 
 /// Everything SUMMARY.md lists after the numbered chapters, in order: suffix
 /// chapters that show no code of their own.
@@ -107,7 +107,7 @@ fn the_answers_appendix_answers_every_exercise_of_every_chapter() {
 }
 
 #[test]
-fn every_chapter_file_is_in_the_summary_and_there_are_twelve_chapters() {
+fn every_chapter_file_is_in_the_summary_and_there_are_thirteen_chapters() {
     let listed: Vec<String> = chapters().into_iter().map(|(n, _)| n).collect();
     assert_eq!(
         listed.len(),
@@ -779,5 +779,56 @@ fn no_table_row_shows_more_than_two_pictures() {
                 "{name}: {pictures} pictures in one row: {line}"
             );
         }
+    }
+}
+
+/// FNV-1a, 64 bits, as tests/serve.rs records each screenshot's bytes.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// Chapter 13's screenshots come from Chromium, so they cannot be made again
+/// byte for byte: each one shown must be one the browser test wrote with its
+/// record (`shots.json`: size and fingerprint of each file), made by the command
+/// the chapter shows.
+#[test]
+fn the_studio_screenshots_are_those_the_browser_test_recorded() {
+    let folder = root().join("chapters/studio");
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(folder.join("shots.json")).unwrap()).unwrap();
+    let command = record["made_by"].as_str().unwrap();
+    assert!(command.contains("cargo test --test serve studio_page"));
+    let text = chapter("13");
+    assert!(text.contains(command), "chapter 13 shows `{command}`");
+    let shots = record["shots"].as_array().unwrap();
+    // Kept out of img/, whose every file `raystep figures` makes.
+    let shown: Vec<String> = text
+        .match_indices("](studio/")
+        .map(|(i, _)| {
+            let start = i + 2;
+            text[start..start + text[start..].find(')').unwrap()].to_string()
+        })
+        .collect();
+    assert!(shown.len() >= 4, "{shown:?}");
+    for image in &shown {
+        let file = image.trim_start_matches("studio/");
+        let entry = shots
+            .iter()
+            .find(|s| s["file"] == file)
+            .unwrap_or_else(|| panic!("{image} is not one the browser test recorded"));
+        let bytes = std::fs::read(folder.join(file)).unwrap();
+        assert_eq!(entry["bytes"], bytes.len(), "{file}: run `{command}`");
+        assert_eq!(
+            entry["fnv1a64"],
+            format!("{:016x}", fnv1a(&bytes)),
+            "{file} is not the file the test wrote: run `{command}`"
+        );
+        let size = image::image_dimensions(folder.join(file)).unwrap();
+        assert_eq!(
+            (entry["width"].clone(), entry["height"].clone()),
+            (size.0.into(), size.1.into())
+        );
     }
 }

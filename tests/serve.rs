@@ -25,7 +25,15 @@ struct Server {
 impl Server {
     /// Start `raystep serve [scene] --port 0` and read the address it prints.
     fn start(scene: Option<&Path>) -> Server {
+        Server::start_in(None, scene)
+    }
+
+    /// [`Server::start`] in the folder `dir` (a relative `scene` is in it).
+    fn start_in(dir: Option<&Path>, scene: Option<&Path>) -> Server {
         let mut command = Command::new(env!("CARGO_BIN_EXE_raystep"));
+        if let Some(dir) = dir {
+            command.current_dir(dir);
+        }
         command.arg("serve");
         if let Some(scene) = scene {
             command.arg(scene);
@@ -353,6 +361,311 @@ fn the_scene_is_json_with_a_version_and_the_page_is_served() {
         "POST /api/scene HTTP/1.1\r\nHost: {host}\r\nContent-Length: 0\r\nConnection: close\r\n\r\n"
     ));
     assert_eq!(post.status, 405);
+}
+
+/// Run the command line, which must succeed.
+fn raystep_ok(args: &[&str]) -> std::process::Output {
+    let out = raystep(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+#[test]
+fn diff_answers_the_figures_raystep_diff_gives_for_the_two_renders() {
+    let (dir, scene) = scene_folder();
+    let server = Server::start(Some(&scene));
+    let s = scene.to_str().unwrap();
+    // A: every stage; B: without shadows, in float32.
+    let (qa, qb) = (
+        "width=60&height=40",
+        "width=60&height=40&without=shadow&precision=f32",
+    );
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    let size = ["--width", "60", "--height", "40"];
+    let mut args = vec!["render", s, "--out", a.to_str().unwrap()];
+    args.extend_from_slice(&size);
+    raystep_ok(&args);
+    let mut args = vec!["render", s, "--out", b.to_str().unwrap()];
+    args.extend_from_slice(&size);
+    args.extend_from_slice(&["--without", "shadow", "--precision", "f32"]);
+    raystep_ok(&args);
+    let cli = raystep(&[
+        "diff",
+        a.join("buffers.exr").to_str().unwrap(),
+        b.join("buffers.exr").to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(cli.status.code(), Some(1), "different");
+    let cli: Value = serde_json::from_slice(&cli.stdout).unwrap();
+    let encode_side = |q: &str| q.replace('=', "%3D").replace('&', "%26");
+    let reply = server.get(&format!(
+        "/api/diff?a={}&b={}",
+        encode_side(qa),
+        encode_side(qb)
+    ));
+    assert_eq!(
+        reply.status,
+        200,
+        "{}",
+        String::from_utf8_lossy(&reply.body)
+    );
+    let api = reply.json();
+    for key in [
+        "schema",
+        "width",
+        "height",
+        "pixels",
+        "threshold",
+        "fail_percent",
+        "over_threshold",
+        "over_threshold_percent",
+        "over_one_step",
+        "largest",
+        "largest_at",
+        "rmse",
+        "clipped",
+        "non_finite",
+        "different",
+    ] {
+        assert_eq!(api[key], cli[key], "{key}");
+    }
+    assert!(api["over_one_step"].as_u64().unwrap() > 100);
+    assert_eq!(api["a_version"], 1);
+    // Both were rendered for it; their beauty is kept for the next.
+    assert_eq!(reply.header("X-Raystep-Renders"), Some("2"));
+    // A against itself: nothing differs, and nothing is rendered again.
+    let same = server.get(&format!("/api/diff?a={0}&b={0}", encode_side(qa)));
+    assert_eq!(same.header("X-Raystep-Renders"), Some("0"));
+    let same = same.json();
+    assert_eq!(same["over_one_step"], 0);
+    assert_eq!(same["rmse"], 0.0);
+    assert_eq!(same["different"], false);
+    // A render the page asked for is kept too: its diff renders only the other.
+    let qc = "width=60&height=40&stage=shadow";
+    assert_eq!(
+        server.get(&format!("/api/render?{qc}&buffer=depth")).status,
+        200
+    );
+    let third = server.get(&format!(
+        "/api/diff?a={}&b={}",
+        encode_side(qc),
+        encode_side("width=60&height=40&tutorial")
+    ));
+    assert_eq!(third.status, 200);
+    assert_eq!(third.header("X-Raystep-Renders"), Some("1"));
+    // Refusals: two sizes, a side missing, a bad option on one side (named).
+    let sizes = server.get(&format!(
+        "/api/diff?a={}&b=width%3D61%26height%3D40",
+        encode_side(qa)
+    ));
+    assert_eq!(sizes.status, 400);
+    assert_eq!(
+        sizes.error(),
+        "a is 60 × 40 but b is 61 × 40: only renders of one size compare"
+    );
+    let missing = server.get(&format!("/api/diff?a={}", encode_side(qa)));
+    assert_eq!(missing.status, 400);
+    assert!(missing.error().starts_with("give the two renders"));
+    let bad = server.get(&format!("/api/diff?a={}&b=spp%3D3", encode_side(qa)));
+    assert_eq!(bad.status, 400);
+    assert!(bad.error().starts_with("b: "), "{}", bad.error());
+    let stray = server.get("/api/diff?a=&b=&width=3");
+    assert_eq!(stray.status, 400);
+}
+
+#[test]
+fn the_light_and_the_camera_moved_render_and_save_as_the_scene_file_does() {
+    let (dir, scene) = scene_folder();
+    let server = Server::start(Some(&scene));
+    let moved = "light=1.5,4,-2&camera=0.25,-0.1,1";
+    let saved = server.get(&format!("/api/scene.toml?{moved}"));
+    assert_eq!(
+        saved.status,
+        200,
+        "{}",
+        String::from_utf8_lossy(&saved.body)
+    );
+    assert!(saved
+        .header("Content-Disposition")
+        .unwrap()
+        .starts_with("attachment; filename=\"scene-studio.toml\""));
+    // The file's own lines, comments too, with the two positions replaced.
+    let text = String::from_utf8(saved.body.clone()).unwrap();
+    let seed = raystep::io::scene_file::SEED_TOML;
+    let expected = seed
+        .replace("position = [5, 5, 5]", "position = [1.5, 4.0, -2.0]")
+        .replace("position = [0, 0, 1]", "position = [0.25, -0.1, 1.0]");
+    assert_eq!(text, expected);
+    // A scene without the tables gets them, at the end.
+    let bare = raystep::tools::serve::api::Edits {
+        light: Some([1.0, 2.0, 3.0]),
+        camera: None,
+    }
+    .apply(
+        "[[sphere]]\ncenter = [0, 0, -1]\nradius = 0.5\n",
+        "bare.toml",
+    )
+    .unwrap();
+    assert!(
+        bare.ends_with("\n[light]\nposition = [1.0, 2.0, 3.0]\n"),
+        "{bare}"
+    );
+    // A position written over several lines: the text is written again.
+    let spread = raystep::tools::serve::api::Edits {
+        light: Some([1.0, 2.0, 3.0]),
+        camera: None,
+    }
+    .apply(
+        "[light]\nposition = [\n  5,\n  5,\n  5,\n]\n",
+        "spread.toml",
+    )
+    .unwrap();
+    let table: toml::Table = spread.parse().unwrap();
+    assert_eq!(table["light"]["position"].as_array().unwrap().len(), 3);
+    assert_eq!(table["light"]["position"][0].as_float(), Some(1.0));
+    let path = dir.path().join("saved.toml");
+    std::fs::write(&path, &saved.body).unwrap();
+    let p = path.to_str().unwrap();
+    // The saved file says what the page changed, and renders as the API did.
+    let check = raystep_ok(&["check", p, "--json"]);
+    let check: Value = serde_json::from_slice(&check.stdout).unwrap();
+    let text = check.to_string();
+    assert!(text.contains("1.5") && text.contains("0.25"), "{text}");
+    let out = dir.path().join("out");
+    raystep_ok(&[
+        "render",
+        p,
+        "--width",
+        "60",
+        "--height",
+        "40",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let reply = server.get(&format!("/api/render?{moved}&width=60&height=40"));
+    assert_eq!(reply.status, 200);
+    assert!(reply.body == std::fs::read(out.join("beauty.png")).unwrap());
+    let unmoved = server.get("/api/render?width=60&height=40");
+    assert!(reply.body != unmoved.body, "the move changes the picture");
+    // The pixel's story too.
+    let cli = raystep_ok(&[
+        "explain", p, "--pixel", "30,20", "--json", "--width", "60", "--height", "40",
+    ]);
+    let story = server.get(&format!("/api/pixel?x=30&y=20&{moved}&width=60&height=40"));
+    assert_eq!(
+        String::from_utf8_lossy(&story.body),
+        String::from_utf8_lossy(&cli.stdout)
+    );
+    // No change: the file's own text, as it is.
+    let plain = server.get("/api/scene.toml");
+    assert_eq!(plain.body, raystep::io::scene_file::SEED_TOML.as_bytes());
+    for bad in [
+        "light=1,2",
+        "light=1,2,nan",
+        "camera=a,b,c",
+        "light=1e9,0,0",
+        "width=3",
+    ] {
+        let reply = server.get(&format!("/api/scene.toml?{bad}"));
+        assert_eq!(reply.status, 400, "{bad}");
+        assert!(!reply.error().is_empty());
+    }
+    assert_eq!(server.get("/api/render?light=1,2").status, 400);
+}
+
+#[test]
+fn a_render_a_newer_request_of_its_view_supersedes_is_cancelled() {
+    let server = Server::start(None);
+    let port = server.port;
+    // A render of minutes (1920 × 1080, 64 samples a pixel, in a debug build).
+    let slow = std::thread::spawn(move || {
+        let started = Instant::now();
+        let reply = exchange(
+            port,
+            &format!(
+                "GET /api/render?view=main&width=1920&height=1080&spp=64 HTTP/1.1\r\n\
+                 Host: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n"
+            ),
+        );
+        (reply, started.elapsed())
+    });
+    // Newer renders of the same view, until the slow one has answered: one of
+    // them comes after it started and supersedes it.
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let mut newer = Vec::new();
+    while !slow.is_finished() {
+        assert!(
+            Instant::now() < deadline,
+            "the slow render is still running"
+        );
+        newer.push(
+            server
+                .get("/api/render?view=main&width=30&height=20")
+                .status,
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let (reply, took) = slow.join().unwrap();
+    assert_eq!(
+        reply.status,
+        409,
+        "{}",
+        String::from_utf8_lossy(&reply.body)
+    );
+    assert_eq!(
+        reply.error(),
+        "cancelled: a newer request of view main superseded this one"
+    );
+    eprintln!("superseded after {took:?}, {} newer requests", newer.len());
+    // The newer ones were answered (the last one at least: nothing came after it).
+    assert_eq!(newer.last(), Some(&200));
+    // Other views, and requests without one, are left alone.
+    assert_eq!(
+        server
+            .get("/api/render?view=other&width=30&height=20")
+            .status,
+        200
+    );
+    assert_eq!(server.get("/api/render?view=a%20b").status, 400);
+}
+
+/// The seam the server cancels through: once the flag is set no row starts,
+/// and the answer is none; never set, the frame is the plain render's.
+#[test]
+fn a_cancelled_render_stops_taking_rows() {
+    use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+    for engine in [raystep::stages::Engine::Book, raystep::stages::Engine::Fast] {
+        let scene = common::seed(64, 400);
+        let mut settings: raystep::render::Settings = raystep::stages::Stages::ALL.into();
+        settings.engine = engine;
+        let cancel = AtomicBool::new(false);
+        let rows = AtomicU64::new(0);
+        let frame = raystep::engine::render_cancellable(
+            &scene,
+            &settings,
+            &|n| {
+                rows.fetch_add(n, Ordering::SeqCst);
+                cancel.store(true, Ordering::SeqCst);
+            },
+            &cancel,
+        );
+        assert!(frame.is_none(), "{engine:?}");
+        // Each thread finishes at most the row it had started.
+        let done = rows.load(Ordering::SeqCst);
+        assert!(
+            done <= rayon::current_num_threads() as u64,
+            "{engine:?}: {done} rows of 400 after the cancel"
+        );
+        let never = AtomicBool::new(false);
+        let whole = raystep::engine::render_cancellable(&scene, &settings, &|_| {}, &never)
+            .expect("finished");
+        let plain = raystep::engine::render(&scene, &settings, &|_| {});
+        assert!(whole.pixels == plain.pixels, "{engine:?}");
+    }
 }
 
 /// The command line's message for `args`, as it prints it on stderr (without
@@ -785,6 +1098,11 @@ fn key() -> impl Strategy<Value = String> {
             "help",
             "version",
             "scene",
+            "view",
+            "light",
+            "camera",
+            "a",
+            "b",
             "",
         ])
         .prop_map(String::from),
@@ -835,6 +1153,11 @@ fn value() -> impl Strategy<Value = String> {
             "%2e%2e",
             "..",
             "/etc/passwd",
+            "main",
+            "1,2,3",
+            "1,2",
+            "1e300,0,0",
+            "width%3D9%26height%3D9",
         ])
         .prop_map(String::from),
         (0u32..100).prop_map(|n| n.to_string()),
@@ -870,6 +1193,21 @@ proptest! {
                 prop_assert!(!refusal.message.is_empty());
             }
         }
+        // The page's other queries: a diff's two sides, a scene to save.
+        match studio.diff_jobs(&query) {
+            Ok(jobs) => {
+                prop_assert!(jobs.a.pixels() <= raystep::io::scene_file::MAX_PIXELS);
+                prop_assert_eq!(jobs.a.pixels(), jobs.b.pixels());
+            }
+            Err(refusal) => {
+                prop_assert_eq!(refusal.status, 400);
+                prop_assert!(!refusal.message.is_empty());
+            }
+        }
+        if let Err(refusal) = studio.scene_toml(&query) {
+            prop_assert_eq!(refusal.status, 400);
+            prop_assert!(!refusal.message.is_empty());
+        }
         match studio.pixel(&format!("x=1&y=1&{query}")) {
             Ok(json) => {
                 let story: Value = serde_json::from_str(&json).unwrap();
@@ -903,11 +1241,30 @@ fn encode(pairs: &[(String, String)]) -> String {
         .join("&")
 }
 
+/// Where the browser test writes the book's screenshots when asked to make
+/// them (`RAYSTEP_STUDIO_SHOTS=chapters/studio`), with their record.
+const SHOTS_VARIABLE: &str = "RAYSTEP_STUDIO_SHOTS";
+
+/// The command that makes the book's screenshots, as chapter 13 shows it.
+pub const SHOTS_COMMAND: &str =
+    "RAYSTEP_STUDIO_SHOTS=chapters/studio cargo test --test serve studio_page";
+
+/// FNV-1a, 64 bits: the record's fingerprint of each screenshot's bytes.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
 /// The page in a real headless Chromium (`tests/browser/studio.mjs`): stages
-/// switched, a refusal shown with the command line's reason, a buffer picked, a
-/// pixel's story read (exactly `explain --json`), and a saved scene followed.
+/// switched, a refusal shown with the command line's reason, a buffer picked and
+/// shown in false colour, a pixel's story read (exactly `explain --json`), zoom to
+/// single pixels, A/B with `raystep diff`'s figures, the light dragged and the
+/// scene saved as a file, and a saved scene followed. With
+/// `RAYSTEP_STUDIO_SHOTS=DIR`, its screenshots are kept in DIR for the book,
+/// with a record (`shots.json`) that tests/book.rs checks them against.
 #[test]
-fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_file() {
+fn the_studio_page_zooms_compares_drags_tells_a_pixels_story_and_follows_the_file() {
     let Some(chromium) = common::required(common::browser_tools(), "the browser test") else {
         return;
     };
@@ -915,10 +1272,22 @@ fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_
     let new_scene = dir.path().join("new.toml");
     let text = raystep::io::scene_file::SEED_TOML;
     std::fs::write(&new_scene, text.replace("radius = 0.7", "radius = 0.5")).unwrap();
-    let server = Server::start(Some(&scene));
-    const VIEWPORT: (u32, u32) = (1400, 1000);
+    // Served by its name in its folder, as a reader would: the page shows it.
+    let server = Server::start_in(Some(dir.path()), Some(Path::new("scene.toml")));
+    const VIEWPORT: (u32, u32) = (1400, 900);
     let (x, y) = (150, 120);
     let screenshot = dir.path().join("studio.png");
+    let book_shots = std::env::var_os(SHOTS_VARIABLE).map(|d| {
+        let d = PathBuf::from(d);
+        match d.is_absolute() {
+            true => d,
+            false => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(d),
+        }
+    });
+    let shots = book_shots
+        .clone()
+        .unwrap_or_else(|| dir.path().join("shots"));
+    let download = dir.path().join("saved.toml");
     // The story the page must tell, before the page changes the scene file.
     let pixel = format!("{x},{y}");
     let explain = Command::new(env!("CARGO_BIN_EXE_raystep"))
@@ -927,6 +1296,26 @@ fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_
         .args(["--pixel", &pixel, "--json", "--stage", "plane"])
         .output()
         .unwrap();
+    // `raystep diff`'s figures for the A/B the page makes, of the scene as it is
+    // then (the page saves a new one later).
+    let s = scene.to_str().unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    raystep_ok(&["render", s, "--out", a.to_str().unwrap()]);
+    raystep_ok(&[
+        "render",
+        s,
+        "--without",
+        "shadow",
+        "--out",
+        b.to_str().unwrap(),
+    ]);
+    let cli = raystep(&[
+        "diff",
+        a.join("buffers.exr").to_str().unwrap(),
+        b.join("buffers.exr").to_str().unwrap(),
+        "--json",
+    ]);
+    let cli: Value = serde_json::from_slice(&cli.stdout).unwrap();
     let run = Command::new("node")
         .arg(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/browser/studio.mjs"))
         .arg("--url")
@@ -937,6 +1326,10 @@ fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_
         .arg(&scene)
         .arg("--new-scene")
         .arg(&new_scene)
+        .arg("--shots")
+        .arg(&shots)
+        .arg("--download")
+        .arg(&download)
         .arg("--chromium")
         .arg(&chromium)
         .arg("--size")
@@ -973,6 +1366,17 @@ fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_
             )
         })
         .collect();
+    let light = report["light"]["sent"].as_str().unwrap();
+    let dragged = format!(
+        "stage=plane&light={}&buffer=beauty",
+        light.replace(',', "%2C")
+    );
+    let camera = report["camera"]["sent"].as_str().unwrap();
+    let camera_dragged = format!(
+        "stage=plane&light={}&camera={}&buffer=beauty",
+        light.replace(',', "%2C"),
+        camera.replace(',', "%2C")
+    );
     assert_eq!(
         queries,
         [
@@ -983,29 +1387,121 @@ fn the_studio_page_switches_stages_refuses_tells_a_pixels_story_and_follows_the_
             ("rays off", "stage=plane&buffer=beauty"),
             ("rays on", "stage=plane&buffer=beauty"),
             ("depth", "stage=plane&buffer=depth"),
+            ("beauty", "stage=plane&buffer=beauty"),
+            ("B: shadow off", "stage=plane&without=shadow&buffer=beauty"),
+            ("shadow on again", "stage=plane&buffer=beauty"),
+            ("light dragged", dragged.as_str()),
+            ("camera dragged", camera_dragged.as_str()),
+            ("reset", "stage=plane&buffer=beauty"),
+            ("depth again", "stage=plane&buffer=depth"),
             ("scene saved", "stage=plane&buffer=depth"),
         ]
     );
     // The refusal is the command line's.
-    let s = scene.to_str().unwrap();
     let refused = cli_error(&["render", s, "--stage", "plane", "--without", "rays"]);
     assert_eq!(report["refusal"], refused.as_str());
-    // The story is exactly `explain --json`, of the scene as it was then.
+    // False colour: the grey pixels of the depth picture come out coloured.
+    let grey = report["falseColour"]["before"].as_u64().unwrap();
+    assert!(grey > 20_000, "{grey} grey pixels of 60000");
+    assert!(report["falseColour"]["after"].as_u64().unwrap() < grey / 50);
+    // The story is exactly `explain --json`, of the scene as it was then, with
+    // the values of the buffers.
     let story = report["story"]["json"].as_str().unwrap();
     assert!(story == String::from_utf8_lossy(&explain.stdout), "{story}");
     assert!(report["storyText"].as_str().unwrap().contains("Segment 0"));
+    let buffers = report["storyBuffers"].as_str().unwrap();
+    for name in ["beauty", "depth", "normal", "object", "bounces", "rays"] {
+        assert!(buffers.contains(name), "{name} in {buffers}");
+    }
+    // Zoomed in to 32 screen pixels a pixel, a click picks the next pixel.
+    assert!(report["zoom"]["zoom"].as_f64().unwrap() >= 32.0);
+    assert_eq!(report["zoom"]["x"], x + 1);
+    // A/B: nothing differs between A and itself; with B without shadows, the
+    // figures are `raystep diff`'s for the two renders.
+    assert_eq!(report["ab"]["same"]["over_one_step"], 0);
+    assert_eq!(report["ab"]["a"], "stage=plane");
+    assert_eq!(report["ab"]["b"], "stage=plane&without=shadow");
+    let figures = &report["ab"]["figures"];
+    for key in ["over_one_step", "largest", "largest_at", "rmse", "pixels"] {
+        assert_eq!(figures[key], cli[key], "{key}");
+    }
+    let words = report["ab"]["text"].as_str().unwrap();
+    assert!(
+        words.contains(&format!("{} of 60000 pixels", cli["over_one_step"])),
+        "{words}"
+    );
+    // The light moved right only, and the file saved says where it is.
+    let before = report["light"]["before"].as_str().unwrap();
+    assert_eq!(before, "(5, 5, 5)");
+    let moved: Vec<f64> = light.split(',').map(|v| v.parse().unwrap()).collect();
+    assert!(
+        moved[0] > 5.0 && moved[1] == 5.0 && moved[2] == 5.0,
+        "{moved:?}"
+    );
+    // The camera moved up only (dragged up: +y), and its numbers are shown.
+    let moved: Vec<f64> = camera.split(',').map(|v| v.parse().unwrap()).collect();
+    assert!(
+        moved[0] == 0.0 && moved[1] > 0.0 && moved[2] == 1.0,
+        "{moved:?}"
+    );
+    let shown = report["camera"]["shown"].as_str().unwrap();
+    assert_eq!(shown, format!("(0, {}, 1) moved", moved[1]));
+    assert_eq!(report["saved"]["name"], "scene-studio.toml");
+    let saved = download.to_str().unwrap();
+    raystep_ok(&["check", saved]);
+    let out = dir.path().join("saved");
+    raystep_ok(&["render", saved, "--out", out.to_str().unwrap()]);
+    // The scene file was the built-in scene when it was saved.
+    let api = Server::start(None).get(&format!("/api/render?light={light}"));
+    assert!(api.body == std::fs::read(out.join("beauty.png")).unwrap());
     assert_eq!(report["version"], "2");
 
-    // The screenshot: a PNG of the window's size, not one flat colour; a copy
+    // The screenshots: PNGs of the window's size, not one flat colour; a copy
     // stays in target/ for a person to look at.
-    let bytes = std::fs::read(&screenshot).unwrap();
-    let picture = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
-        .unwrap()
-        .to_rgb8();
-    assert_eq!(picture.dimensions(), VIEWPORT);
-    let colours: std::collections::HashSet<[u8; 3]> = picture.pixels().map(|p| p.0).collect();
-    assert!(colours.len() > 100, "{} colours", colours.len());
+    let mut record = Vec::new();
+    let names = ["overview", "depth-false-colour", "zoom", "ab", "light"];
+    let shot_paths: Vec<PathBuf> = names
+        .iter()
+        .map(|n| shots.join(format!("studio-{n}.png")))
+        .chain([screenshot.clone()])
+        .collect();
+    for path in &shot_paths {
+        let bytes = std::fs::read(path).unwrap();
+        let picture = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+            .unwrap()
+            .to_rgb8();
+        assert_eq!(picture.dimensions(), VIEWPORT, "{}", path.display());
+        let colours: std::collections::HashSet<[u8; 3]> = picture.pixels().map(|p| p.0).collect();
+        assert!(
+            colours.len() > 100,
+            "{}: {} colours",
+            path.display(),
+            colours.len()
+        );
+        record.push(serde_json::json!({
+            "file": path.file_name().unwrap().to_str().unwrap(),
+            "width": VIEWPORT.0,
+            "height": VIEWPORT.1,
+            "bytes": bytes.len(),
+            "fnv1a64": format!("{:016x}", fnv1a(&bytes)),
+        }));
+    }
+    record.pop(); // the last screenshot is not the book's
     let keep = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target");
     std::fs::create_dir_all(&keep).unwrap();
     std::fs::copy(&screenshot, keep.join("studio-screenshot.png")).unwrap();
+    if let Some(book) = book_shots {
+        let manifest = serde_json::json!({
+            "made_by": SHOTS_COMMAND,
+            "note": "screenshots of headless Chromium: not byte-stable from one run to the next, \
+                     so tests/book.rs checks each file against this record, which the test \
+                     writes with them",
+            "shots": record,
+        });
+        std::fs::write(
+            book.join("shots.json"),
+            serde_json::to_string_pretty(&manifest).unwrap() + "\n",
+        )
+        .unwrap();
+    }
 }

@@ -17,6 +17,8 @@ pub mod masks;
 pub mod packet;
 pub mod walk;
 
+use std::sync::atomic::AtomicBool;
+
 use crate::aov::{Frame, Packets, PixelRecord, Rays};
 use crate::fast::lanes::{Laned, WIDTH};
 pub use crate::fast::packet::Fast;
@@ -108,6 +110,7 @@ pub fn render_into(
     settings: &Settings,
     frame: &mut Frame,
     progress: &(dyn Fn(u64) + Sync),
+    cancel: &AtomicBool,
 ) {
     match settings.precision {
         Precision::F32 => render_in(
@@ -116,6 +119,7 @@ pub fn render_into(
             settings,
             frame,
             progress,
+            cancel,
         ),
         Precision::F64 => render_in(
             &Fast::<f64>::new(scene, settings),
@@ -123,6 +127,7 @@ pub fn render_into(
             settings,
             frame,
             progress,
+            cancel,
         ),
     }
 }
@@ -134,10 +139,13 @@ fn render_in<T: Laned>(
     settings: &Settings,
     frame: &mut Frame,
     progress: &(dyn Fn(u64) + Sync),
+    cancel: &AtomicBool,
 ) {
     let width = scene.width as usize;
     assert_eq!(frame.pixels.len(), width * scene.height as usize);
-    let rays = in_rows(frame, width, progress, |row, line| fast.row(row, line));
+    let rays = in_rows(frame, width, progress, cancel, |row, line| {
+        fast.row(row, line)
+    });
     frame.describe(scene, &fast.book, settings, rays);
     frame.engine = Engine::Fast;
     frame.packets = match (fast.packets, fast.avx) {

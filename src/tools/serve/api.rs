@@ -10,14 +10,17 @@
 //! scene is always the one served: no query names a file.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, SystemTime};
 
 use clap::Parser;
+use rayon::prelude::*;
 use serde_json::{json, Value};
 
-use crate::aov::Buffer;
+use crate::aov::{Buffer, Frame};
 use crate::error::Error;
+use crate::io::output::PngEncoding;
 use crate::io::scene_file::{self, SizeOverride};
 use crate::render::Settings;
 use crate::scene::{Role, Scene, Shape};
@@ -67,6 +70,7 @@ fn clap_message(error: &clap::Error) -> String {
     text.strip_prefix("error: ").unwrap_or(text).to_string()
 }
 
+// ANCHOR: query_words
 /// The words of the command line that `query` stands for (each `--key=value`, or
 /// `--key`), and the values of the keys in `taken`, which the endpoint reads
 /// itself (each at most once), in the order of `taken`.
@@ -123,6 +127,7 @@ pub fn query_words(
     }
     Ok((words, values))
 }
+// ANCHOR_END: query_words
 
 /// Parse `raystep WORDS` with the command line's parser.
 fn parse_command(words: Vec<String>) -> Result<Command, Refusal> {
@@ -364,7 +369,15 @@ impl Studio {
     /// The last good scene at the size `size` asks for, as the command line
     /// would load it (the size decides the default screen, so the text is parsed
     /// again at each size), and the version it belongs to.
-    fn scene_at(&self, size: SizeOverride) -> Result<(Scene, u64), Error> {
+    fn scene_at(&self, size: SizeOverride, edits: &Edits) -> Result<(Scene, u64), Error> {
+        if !edits.is_empty() {
+            let (text, version) = {
+                let served = self.lock();
+                (Arc::clone(&served.text), served.version)
+            };
+            let text = edits.apply(&text, &self.name)?;
+            return Ok((scene_file::parse_sized(&text, &self.name, size)?, version));
+        }
         let (text, version) = {
             let served = self.lock();
             if size == SizeOverride::default() {
@@ -389,26 +402,32 @@ impl Studio {
     /// `prepare` of the command line on the served scene: the stages, the scene
     /// at its size, the rules; in that order, so that the first mistake found is
     /// the one the command line reports.
-    fn prepare(&self, frame: &FrameArgs) -> Result<(Scene, Settings, u64), Error> {
+    fn prepare(&self, frame: &FrameArgs, edits: &Edits) -> Result<(Scene, Settings, u64), Error> {
         let stages = Stages::select(frame.stage, &frame.without).map_err(Error::Usage)?;
         let size = SizeOverride {
             width: frame.scene.width,
             height: frame.scene.height,
         };
-        let (mut scene, version) = self.scene_at(size)?;
+        let (mut scene, version) = self.scene_at(size, edits)?;
         let settings = frame.rules.apply(&mut scene, stages)?;
         Ok((scene, settings, version))
     }
 
     /// `GET /api/render?QUERY`: what to render, or why not.
     pub fn render_job(&self, query: &str) -> Result<RenderJob, Refusal> {
-        let (words, taken) = query_words(query, &["buffer"])?;
+        let (words, taken) = query_words(query, &["buffer", "view", "light", "camera"])?;
         let name = taken[0].clone().unwrap_or_else(|| "beauty".to_string());
+        let view = taken[1].as_deref().map(view_name).transpose()?;
+        let edits = Edits::read(&taken[2], &taken[3])?;
+        let said = words.join("\u{1f}");
         let words = std::iter::once("render".to_string()).chain(words).collect();
         let Command::Render(args) = parse_command(words)? else {
             unreachable!("the words begin with `render`")
         };
-        let (scene, settings, version) = self.prepare(&args.frame)?;
+        let (scene, settings, version) = self.prepare(&args.frame, &edits)?;
+        // A render is a function of the scene's text and these: its beauty can
+        // be looked up by them.
+        let key = format!("{version}\u{1e}{said}\u{1e}{edits:?}");
         let Some(buffer) = Buffer::ALL.into_iter().find(|b| b.name() == name) else {
             let names: Vec<&str> = Buffer::ALL.iter().map(|b| b.name()).collect();
             return Err(Refusal::bad(format!(
@@ -427,14 +446,68 @@ impl Studio {
             scene,
             settings,
             buffer,
+            png: args.png,
             version,
+            view,
+            key,
         })
+    }
+
+    /// `GET /api/diff?a=QUERY&b=QUERY`: the two renders (their beauty, as
+    /// `buffers.exr` holds it) that `raystep diff` compares, or why not.
+    pub fn diff_jobs(&self, query: &str) -> Result<DiffJobs, Refusal> {
+        let (words, taken) = query_words(query, &["a", "b", "view"])?;
+        if let Some(word) = words.first() {
+            return Err(Refusal::bad(format!(
+                "{word}: /api/diff takes a=QUERY&b=QUERY, the options of the two renders \
+                 (each a query of /api/render, encoded), and view"
+            )));
+        }
+        let (Some(a), Some(b)) = (&taken[0], &taken[1]) else {
+            return Err(Refusal::bad(
+                "give the two renders as a=QUERY&b=QUERY, each a query of /api/render (encoded)",
+            ));
+        };
+        let view = taken[2].as_deref().map(view_name).transpose()?;
+        let side = |name: &str, query: &str| {
+            self.render_job(query).map_err(|r| Refusal {
+                status: r.status,
+                message: format!("{name}: {}", r.message),
+            })
+        };
+        let (a, b) = (side("a", a)?, side("b", b)?);
+        let size = |job: &RenderJob| (job.scene.width, job.scene.height);
+        if size(&a) != size(&b) {
+            let ((wa, ha), (wb, hb)) = (size(&a), size(&b));
+            return Err(Refusal::bad(format!(
+                "a is {wa} × {ha} but b is {wb} × {hb}: only renders of one size compare"
+            )));
+        }
+        Ok(DiffJobs { a, b, view })
+    }
+
+    /// `GET /api/scene.toml?light=X,Y,Z&camera=X,Y,Z`: the scene's text with the
+    /// page's changes, as a file to save.
+    pub fn scene_toml(&self, query: &str) -> Result<String, Refusal> {
+        let (words, taken) = query_words(query, &["light", "camera"])?;
+        if let Some(word) = words.first() {
+            return Err(Refusal::bad(format!(
+                "{word}: /api/scene.toml takes only light=X,Y,Z and camera=X,Y,Z"
+            )));
+        }
+        let edits = Edits::read(&taken[0], &taken[1])?;
+        let text = Arc::clone(&self.lock().text);
+        let text = edits.apply(&text, &self.name)?;
+        // What is saved loads.
+        scene_file::parse(&text, &self.name)?;
+        Ok(text)
     }
 
     /// `GET /api/pixel?x=X&y=Y&QUERY`: exactly what `raystep explain --pixel X,Y
     /// QUERY --json` prints, or why not.
     pub fn pixel(&self, query: &str) -> Result<String, Refusal> {
-        let (words, taken) = query_words(query, &["x", "y"])?;
+        let (words, taken) = query_words(query, &["x", "y", "light", "camera"])?;
+        let edits = Edits::read(&taken[2], &taken[3])?;
         let (Some(x), Some(y)) = (&taken[0], &taken[1]) else {
             return Err(Refusal::bad(
                 "give the pixel as x=X&y=Y: column and row from the top-left corner",
@@ -451,7 +524,7 @@ impl Studio {
         let Command::Explain(args) = parse_command(words)? else {
             unreachable!("the words begin with `explain`")
         };
-        let (scene, settings, _) = self.prepare(&args.frame)?;
+        let (scene, settings, _) = self.prepare(&args.frame, &edits)?;
         let (x, y) = args.pixel;
         check_pixel(&scene, x, y)?;
         let story = crate::tools::explain::explain(&scene, &settings, x, y);
@@ -488,8 +561,16 @@ pub struct RenderJob {
     pub settings: Settings,
     /// The buffer whose PNG is the answer.
     pub buffer: Buffer,
+    /// How `--png` stores its light.
+    pub png: PngEncoding,
     /// The scene's version.
     pub version: u64,
+    /// The view it draws (`view=NAME`): a newer render of the same view
+    /// supersedes it.
+    pub view: Option<String>,
+    /// What the render depends on (the scene's version, the command line's
+    /// words, the moves): two jobs with one key give the same frame.
+    pub key: String,
 }
 
 impl RenderJob {
@@ -498,17 +579,210 @@ impl RenderJob {
         u64::from(self.scene.width) * u64::from(self.scene.height)
     }
 
-    /// Render, and encode the buffer as `raystep render` writes its PNG file.
-    pub fn run(&self) -> Rendered {
-        let start = std::time::Instant::now();
-        let frame = crate::engine::render(&self.scene, &self.settings, &|_| {});
-        let render_seconds = start.elapsed().as_secs_f64();
-        let png = crate::io::output::png_bytes(&frame, self.buffer);
-        Rendered {
-            png,
-            render_seconds,
-            encode_seconds: start.elapsed().as_secs_f64() - render_seconds,
+    /// The frame, unless `cancel` is set before it is finished.
+    pub fn frame(&self, cancel: &AtomicBool) -> Option<Frame> {
+        crate::engine::render_cancellable(&self.scene, &self.settings, &|_| {}, cancel)
+    }
+}
+
+/// The two renders of `/api/diff`.
+pub struct DiffJobs {
+    /// The first (A).
+    pub a: RenderJob,
+    /// The second (B).
+    pub b: RenderJob,
+    /// The view asking (`view=NAME`).
+    pub view: Option<String>,
+}
+
+/// A frame's beauty, as `buffers.exr` holds it (its `R`, `G`, `B`).
+pub fn beauty(frame: &Frame) -> Beauty {
+    Beauty {
+        width: frame.width,
+        height: frame.height,
+        pixels: frame.pixels.par_iter().map(|p| p.colour).collect(),
+    }
+}
+
+/// The beauty of a render: what `raystep diff` compares.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Beauty {
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// Linear RGB, row by row.
+    pub pixels: Vec<[f32; 3]>,
+}
+
+/// What `raystep diff --json` reports of two renders' beauty (of one size), by
+/// its own code ([`crate::tools::compare`], at its default threshold and fail
+/// percent).
+pub fn diff_json(a: &Beauty, b: &Beauty) -> Value {
+    use crate::tools::compare::{compare, pixels_over};
+    let (pa, pb) = (&a.pixels, &b.pixels);
+    let d = compare(pa, pb, a.width as usize);
+    let threshold = 1.0f32 / 255.0;
+    let over = pixels_over(pa, pb, threshold);
+    let percent = 100.0 * over as f64 / d.pixels.max(1) as f64;
+    let largest = f64::from(d.largest);
+    json!({
+        "width": a.width,
+        "height": a.height,
+        "pixels": d.pixels,
+        "threshold": threshold,
+        "fail_percent": 0.0,
+        "over_threshold": over,
+        "over_threshold_percent": percent,
+        "over_one_step": d.over_one_step,
+        "largest": if largest.is_finite() { json!(largest) } else { Value::Null },
+        "largest_at": { "row": d.largest_at.0, "column": d.largest_at.1 },
+        "rmse": d.rmse,
+        "clipped": [d.saturated.0, d.saturated.1],
+        "non_finite": [d.non_finite.0, d.non_finite.1],
+        "different": percent > 0.0,
+    })
+}
+
+/// A view's name (`view=NAME`): 1 to 64 letters, digits, `-` or `_`.
+fn view_name(name: &str) -> Result<String, Refusal> {
+    let fine = (1..=64).contains(&name.len())
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
+    match fine {
+        true => Ok(name.to_string()),
+        false => Err(Refusal::bad(format!(
+            "view={name}: a view's name is 1 to 64 letters, digits, - or _"
+        ))),
+    }
+}
+
+/// The page's changes to the scene: the light and the camera moved.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Edits {
+    /// `[light] position`.
+    pub light: Option<[f64; 3]>,
+    /// `[camera] position`.
+    pub camera: Option<[f64; 3]>,
+}
+
+impl Edits {
+    /// The edits of `light=X,Y,Z` and `camera=X,Y,Z`.
+    pub fn read(light: &Option<String>, camera: &Option<String>) -> Result<Edits, Refusal> {
+        let point = |key: &str, text: &Option<String>| -> Result<Option<[f64; 3]>, Refusal> {
+            let Some(text) = text else { return Ok(None) };
+            let numbers: Vec<f64> = text
+                .split(',')
+                .map(|n| n.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .unwrap_or_default();
+            match numbers[..] {
+                [x, y, z] if numbers.iter().all(|n| n.is_finite() && n.abs() <= 1e6) => {
+                    Ok(Some([x, y, z]))
+                }
+                _ => Err(Refusal::bad(format!(
+                    "{key}={text}: give a point as three numbers X,Y,Z (each at most 1e6 \
+                     in size)"
+                ))),
+            }
+        };
+        Ok(Edits {
+            light: point("light", light)?,
+            camera: point("camera", camera)?,
+        })
+    }
+
+    /// Whether nothing is changed.
+    pub fn is_empty(&self) -> bool {
+        self == &Edits::default()
+    }
+
+    /// The scene's TOML `text` with the changes made: each position set in its
+    /// table (made if the file has none). The file's own lines are kept, its
+    /// comments too, with each `position = ...` line replaced ([`Edits::in_place`]);
+    /// when that does not give exactly the values asked for (a position written
+    /// over several lines, an inline table), the text is written again from its
+    /// values, without the comments.
+    pub fn apply(&self, text: &str, file: &str) -> Result<String, Error> {
+        if self.is_empty() {
+            return Ok(text.to_string());
         }
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let mut table: toml::Table = text.parse().map_err(|e: toml::de::Error| Error::Scene {
+            file: file.to_string(),
+            message: e.to_string(),
+        })?;
+        for (name, point) in [("light", self.light), ("camera", self.camera)] {
+            let Some(point) = point else { continue };
+            let section = table
+                .entry(name)
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            let Some(section) = section.as_table_mut() else {
+                return Err(Error::Scene {
+                    file: file.to_string(),
+                    message: format!("`{name}` is not a table"),
+                });
+            };
+            let value = point.iter().map(|&c| toml::Value::Float(c)).collect();
+            section.insert("position".into(), toml::Value::Array(value));
+        }
+        let kept = self.in_place(text);
+        if kept.parse::<toml::Table>().ok().as_ref() == Some(&table) {
+            return Ok(kept);
+        }
+        toml::to_string(&table).map_err(|e| Error::Scene {
+            file: file.to_string(),
+            message: e.to_string(),
+        })
+    }
+
+    /// `text` with each moved position's line replaced, line by line: in the
+    /// table's `position = ...` line (a comment after it kept), or as a new line
+    /// under the table's header, or in a new table at the end. Not checked here:
+    /// [`Edits::apply`] takes it only if it reads as the values asked for.
+    fn in_place(&self, text: &str) -> String {
+        // The name of the table a header line opens (`[light]` -> light); any
+        // line starting with `[` ends the table before it.
+        let header = |line: &str| -> Option<String> {
+            let line = line.trim_start();
+            let inner = line.strip_prefix('[')?.split(']').next()?;
+            Some(inner.trim().to_string())
+        };
+        let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+        for (name, point) in [("light", self.light), ("camera", self.camera)] {
+            let Some([x, y, z]) = point else { continue };
+            let value = format!("position = [{x:?}, {y:?}, {z:?}]");
+            let Some(start) = lines
+                .iter()
+                .position(|l| header(l).as_deref() == Some(name))
+            else {
+                lines.extend([String::new(), format!("[{name}]"), value]);
+                continue;
+            };
+            let end = lines[start + 1..]
+                .iter()
+                .position(|l| header(l).is_some())
+                .map_or(lines.len(), |i| start + 1 + i);
+            let is_position = |l: &String| {
+                let l = l.trim_start();
+                l.strip_prefix("position")
+                    .is_some_and(|rest| rest.trim_start().starts_with('='))
+            };
+            match (start + 1..end).find(|&i| is_position(&lines[i])) {
+                Some(i) => {
+                    let comment = lines[i].find('#').map_or("", |c| &lines[i][c..]);
+                    let comment = if comment.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" {comment}")
+                    };
+                    lines[i] = format!("{value}{comment}");
+                }
+                None => lines.insert(start + 1, value),
+            }
+        }
+        lines.join("\n") + "\n"
     }
 }
 

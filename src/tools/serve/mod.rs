@@ -22,6 +22,7 @@
 
 pub mod api;
 
+use std::collections::{HashMap, VecDeque};
 use std::io::Write;
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -108,6 +109,8 @@ pub fn run(args: &ServeArgs) -> Result<(), Error> {
         studio,
         port,
         gate: Gate::default(),
+        views: Views::default(),
+        beauties: Beauties::default(),
         streams: Arc::new(AtomicUsize::new(0)),
         stopping: AtomicBool::new(false),
     });
@@ -173,6 +176,8 @@ struct Shared {
     studio: Arc<Studio>,
     port: u16,
     gate: Gate,
+    views: Views,
+    beauties: Beauties,
     streams: Arc<AtomicUsize>,
     stopping: AtomicBool,
 }
@@ -184,6 +189,54 @@ struct Gate {
     freed: Condvar,
 }
 
+/// The renders under way (or waiting) of each view (`view=NAME`): a newer
+/// request of a view cancels the one before it.
+#[derive(Default)]
+struct Views {
+    current: Mutex<HashMap<String, Arc<AtomicBool>>>,
+}
+
+/// A request's claim on its view: its cancel flag, let go when dropped.
+struct Claim<'a> {
+    views: &'a Views,
+    view: Option<String>,
+    cancel: Arc<AtomicBool>,
+}
+
+// ANCHOR: supersede
+impl Views {
+    /// Claim `view` for a new request, cancelling the one that had it. No view:
+    /// a flag nobody else sets.
+    fn claim(&self, view: Option<&str>) -> Claim<'_> {
+        let cancel = Arc::new(AtomicBool::new(false));
+        if let Some(view) = view {
+            let mut current = self.current.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(older) = current.insert(view.to_string(), Arc::clone(&cancel)) {
+                older.store(true, Ordering::SeqCst);
+            }
+        }
+        Claim {
+            views: self,
+            view: view.map(str::to_string),
+            cancel,
+        }
+    }
+}
+
+impl Drop for Claim<'_> {
+    fn drop(&mut self) {
+        let Some(view) = &self.view else { return };
+        let mut current = self.views.current.lock().unwrap_or_else(|e| e.into_inner());
+        if current
+            .get(view)
+            .is_some_and(|c| Arc::ptr_eq(c, &self.cancel))
+        {
+            current.remove(view);
+        }
+    }
+}
+// ANCHOR_END: supersede
+
 /// A render's place among those in flight, given back when dropped.
 struct Turn<'a> {
     gate: &'a Gate,
@@ -192,9 +245,13 @@ struct Turn<'a> {
 
 impl Gate {
     /// Wait for a turn to render `pixels`, until `deadline` or an interrupt.
-    fn enter(&self, pixels: u64, deadline: Instant) -> Option<Turn<'_>> {
+    /// A render superseded meanwhile (`cancel` set) leaves the line at once.
+    fn enter(&self, pixels: u64, deadline: Instant, cancel: &AtomicBool) -> Option<Turn<'_>> {
         let mut running = self.running.lock().unwrap_or_else(|e| e.into_inner());
         loop {
+            if cancel.load(Ordering::SeqCst) {
+                return None;
+            }
             let (count, busy) = *running;
             // A render alone may always run: its size is within the limits.
             if count == 0 || (count < RENDERS_AT_ONCE && busy + pixels <= MAX_PIXELS) {
@@ -355,12 +412,166 @@ fn answer(shared: &Shared, request: Request) {
             Err(refusal) => refuse(request, &refusal),
         },
         "/api/render" => render(shared, request, query),
+        "/api/diff" => diff(shared, request, query),
+        "/api/scene.toml" => match studio.scene_toml(query) {
+            Ok(text) => {
+                let name = studio
+                    .path()
+                    .and_then(|p| p.file_stem())
+                    .and_then(|s| s.to_str())
+                    .filter(|s| {
+                        s.chars()
+                            .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+                    })
+                    .unwrap_or("scene");
+                let disposition = format!("attachment; filename=\"{name}-studio.toml\"");
+                send(
+                    request,
+                    200,
+                    "application/toml; charset=utf-8",
+                    text.into_bytes(),
+                    &[("Content-Disposition", disposition)],
+                )
+            }
+            Err(refusal) => refuse(request, &refusal),
+        },
         "/api/events" => events(shared, request),
         _ => error(
             request,
             404,
-            "no such page: the studio has /, /api/scene, /api/render, /api/pixel and /api/events",
+            "no such page: the studio has /, /api/scene, /api/scene.toml, /api/render, \
+             /api/pixel, /api/diff and /api/events",
         ),
+    }
+}
+
+/// Why a render gave no frame.
+enum NoFrame {
+    /// It waited its whole [`QUEUE_WAIT`] in line.
+    Busy,
+    /// A newer request of its view superseded it.
+    Superseded,
+    /// The server is stopping.
+    Stopping,
+}
+
+/// Say why a render gave no frame.
+fn no_frame(request: Request, why: NoFrame, view: Option<&str>) {
+    match why {
+        NoFrame::Busy => {
+            let retry = [("Retry-After", "1".to_string())];
+            let body = Refusal {
+                status: 503,
+                message: format!(
+                    "busy: {RENDERS_AT_ONCE} renders at once, and this one waited {} s; \
+                     try again",
+                    QUEUE_WAIT.as_secs()
+                ),
+            }
+            .json();
+            send(request, 503, JSON, body.into_bytes(), &retry)
+        }
+        NoFrame::Superseded => error(
+            request,
+            409,
+            &format!(
+                "cancelled: a newer request of view {} superseded this one",
+                view.unwrap_or("?")
+            ),
+        ),
+        NoFrame::Stopping => error(request, 503, "the server is stopping"),
+    }
+}
+
+/// Wait for a turn and render `job`'s frame, unless `cancel` is set first.
+fn frame_of(
+    shared: &Shared,
+    job: &api::RenderJob,
+    cancel: &AtomicBool,
+) -> Result<(crate::aov::Frame, f64), NoFrame> {
+    let turn = shared
+        .gate
+        .enter(job.pixels(), Instant::now() + QUEUE_WAIT, cancel);
+    let why = || match () {
+        () if crate::interrupt::requested() => NoFrame::Stopping,
+        () if cancel.load(Ordering::SeqCst) => NoFrame::Superseded,
+        () => NoFrame::Busy,
+    };
+    let Some(turn) = turn else { return Err(why()) };
+    let start = Instant::now();
+    let frame = job.frame(cancel);
+    let seconds = start.elapsed().as_secs_f64();
+    drop(turn);
+    match frame {
+        Some(frame) if !crate::interrupt::requested() => Ok((frame, seconds)),
+        _ => Err(why()),
+    }
+}
+
+/// `GET /api/diff?a=QUERY&b=QUERY`: `raystep diff`'s figures for the beauty of
+/// the two renders, as JSON.
+fn diff(shared: &Shared, request: Request, query: &str) {
+    let jobs = match shared.studio.diff_jobs(query) {
+        Ok(jobs) => jobs,
+        Err(refusal) => return refuse(request, &refusal),
+    };
+    let claim = shared.views.claim(jobs.view.as_deref());
+    let mut renders = 0;
+    let mut beauty_of = |job: &api::RenderJob| match shared.beauties.get(&job.key) {
+        Some(beauty) => Ok(beauty),
+        None => frame_of(shared, job, &claim.cancel).map(|(frame, _)| {
+            renders += 1;
+            shared.beauties.put(&job.key, api::beauty(&frame))
+        }),
+    };
+    let beauties = beauty_of(&jobs.a).and_then(|a| beauty_of(&jobs.b).map(|b| (a, b)));
+    match beauties {
+        Ok((a, b)) => {
+            let mut figures = api::diff_json(&a, &b);
+            figures["a_version"] = jobs.a.version.into();
+            figures["b_version"] = jobs.b.version.into();
+            let body = crate::tools::cli::json_text(&figures, true) + "\n";
+            let extra = [("X-Raystep-Renders", renders.to_string())];
+            send(request, 200, JSON, body.into_bytes(), &extra)
+        }
+        Err(why) => no_frame(request, why, jobs.view.as_deref()),
+    }
+}
+
+/// Pixels of beauty kept for `/api/diff` (12 bytes each: about 100 MB).
+const BEAUTY_PIXELS: u64 = 4 * 1920 * 1080;
+
+/// The beauty of the latest renders, by their [`api::RenderJob::key`]: the page
+/// renders A and B before it asks for their difference, which then needs no
+/// render of its own.
+#[derive(Default)]
+struct Beauties {
+    kept: Mutex<VecDeque<(String, Arc<api::Beauty>)>>,
+}
+
+impl Beauties {
+    fn get(&self, key: &str) -> Option<Arc<api::Beauty>> {
+        let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        kept.iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, b)| Arc::clone(b))
+    }
+
+    /// Keep `beauty` under `key` (the oldest leave to stay within
+    /// [`BEAUTY_PIXELS`]), and give it back.
+    fn put(&self, key: &str, beauty: api::Beauty) -> Arc<api::Beauty> {
+        let beauty = Arc::new(beauty);
+        let size = |b: &api::Beauty| b.pixels.len() as u64;
+        if size(&beauty) > BEAUTY_PIXELS {
+            return beauty;
+        }
+        let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        kept.retain(|(k, _)| k != key);
+        kept.push_back((key.to_string(), Arc::clone(&beauty)));
+        while kept.iter().map(|(_, b)| size(b)).sum::<u64>() > BEAUTY_PIXELS {
+            kept.pop_front();
+        }
+        beauty
     }
 }
 
@@ -370,23 +581,23 @@ fn render(shared: &Shared, request: Request, query: &str) {
         Ok(job) => job,
         Err(refusal) => return refuse(request, &refusal),
     };
-    let Some(turn) = shared.gate.enter(job.pixels(), Instant::now() + QUEUE_WAIT) else {
-        let retry = [("Retry-After", "1".to_string())];
-        let body = Refusal {
-            status: 503,
-            message: format!(
-                "busy: {RENDERS_AT_ONCE} renders at once, and this one waited {} s; try again",
-                QUEUE_WAIT.as_secs()
-            ),
-        }
-        .json();
-        return send(request, 503, JSON, body.into_bytes(), &retry);
+    let claim = shared.views.claim(job.view.as_deref());
+    let (frame, render_seconds) = match frame_of(shared, &job, &claim.cancel) {
+        Ok(done) => done,
+        Err(why) => return no_frame(request, why, job.view.as_deref()),
     };
-    let done = job.run();
-    drop(turn);
-    if crate::interrupt::requested() {
-        return error(request, 503, "the server is stopping");
+    drop(claim);
+    // Kept for a diff, unless too large to keep (then not even copied).
+    if job.pixels() <= BEAUTY_PIXELS {
+        shared.beauties.put(&job.key, api::beauty(&frame));
     }
+    let encoding = Instant::now();
+    let png = crate::io::output::png_bytes_as(&frame, job.buffer, job.png);
+    let done = api::Rendered {
+        png,
+        render_seconds,
+        encode_seconds: encoding.elapsed().as_secs_f64(),
+    };
     let extra = [
         (
             "X-Raystep-Render-Seconds",
