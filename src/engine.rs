@@ -5,13 +5,13 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::aov::Frame;
-use crate::render::Settings;
+use crate::render::{Progress, Settings};
 use crate::scene::Scene;
 use crate::stages::Engine;
 
-/// Render `scene` under `settings` with the engine they name. `progress(1)` is
-/// called, from any thread, each time a row is finished.
-pub fn render(scene: &Scene, settings: &Settings, progress: &(dyn Fn(u64) + Sync)) -> Frame {
+/// Render `scene` under `settings` with the engine they name, telling `progress`
+/// of each row finished (from any thread).
+pub fn render(scene: &Scene, settings: &Settings, progress: &dyn Progress) -> Frame {
     let mut frame = Frame::blank(scene.camera(), settings.precision);
     render_into(scene, settings, &mut frame, progress);
     frame
@@ -19,13 +19,11 @@ pub fn render(scene: &Scene, settings: &Settings, progress: &(dyn Fn(u64) + Sync
 
 /// [`render`] into a frame of the scene's size that is already allocated (as
 /// `raystep bench` does, to time the render alone).
-pub fn render_into(
-    scene: &Scene,
-    settings: &Settings,
-    frame: &mut Frame,
-    progress: &(dyn Fn(u64) + Sync),
-) {
-    render_unless(scene, settings, frame, progress, &AtomicBool::new(false));
+pub fn render_into(scene: &Scene, settings: &Settings, frame: &mut Frame, progress: &dyn Progress) {
+    match settings.engine {
+        Engine::Book => crate::render::render_into(scene, settings, frame, progress),
+        Engine::Fast => crate::fast::render_into(scene, settings, frame, progress),
+    }
 }
 
 /// [`render`], unless `cancel` is set before it ends: then no new row is
@@ -34,23 +32,16 @@ pub fn render_into(
 pub fn render_cancellable(
     scene: &Scene,
     settings: &Settings,
-    progress: &(dyn Fn(u64) + Sync),
     cancel: &AtomicBool,
 ) -> Option<Frame> {
-    let mut frame = Frame::blank(scene.camera(), settings.precision);
-    render_unless(scene, settings, &mut frame, progress, cancel);
-    (!cancel.load(Ordering::SeqCst)).then_some(frame)
-}
-
-fn render_unless(
-    scene: &Scene,
-    settings: &Settings,
-    frame: &mut Frame,
-    progress: &(dyn Fn(u64) + Sync),
-    cancel: &AtomicBool,
-) {
-    match settings.engine {
-        Engine::Book => crate::render::render_into(scene, settings, frame, progress, cancel),
-        Engine::Fast => crate::fast::render_into(scene, settings, frame, progress, cancel),
+    /// Rows go unreported; the flag is asked before each one.
+    struct Unless<'a>(&'a AtomicBool);
+    impl Progress for Unless<'_> {
+        fn row_done(&self) {}
+        fn cancelled(&self) -> bool {
+            self.0.load(Ordering::Relaxed)
+        }
     }
+    let frame = render(scene, settings, &Unless(cancel));
+    (!cancel.load(Ordering::SeqCst)).then_some(frame)
 }

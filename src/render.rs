@@ -7,8 +7,6 @@
 //! Every pixel is computed on its own from the scene alone, so the image is the
 //! same, byte for byte, whatever the number of threads.
 
-use std::sync::atomic::{AtomicBool, Ordering};
-
 use rayon::prelude::*;
 
 use crate::accel::{Accel, BVH_FROM};
@@ -425,33 +423,38 @@ pub fn direction_colour(direction: Vec3) -> Vec3 {
 
 /// Render `scene` under `settings` with the book's tracer. `progress(1)` is
 /// called, from any thread, each time a row is finished.
-pub fn render(scene: &Scene, settings: &Settings, progress: &(dyn Fn(u64) + Sync)) -> Frame {
+pub fn render(scene: &Scene, settings: &Settings, progress: &dyn Progress) -> Frame {
     let mut frame = Frame::blank(scene.camera(), settings.precision);
-    render_into(
-        scene,
-        settings,
-        &mut frame,
-        progress,
-        &AtomicBool::new(false),
-    );
+    render_into(scene, settings, &mut frame, progress);
     frame
+}
+
+/// Who follows a render row by row: told of each row finished, and asked before
+/// each row is started whether the render is still wanted. Any `Fn(u64)` is one
+/// (called with 1 per row, never cancelling); `raystep serve` passes one that a
+/// newer request cancels.
+pub trait Progress: Sync {
+    /// A row is finished.
+    fn row_done(&self);
+    /// Start no more rows: the frame will be thrown away.
+    fn cancelled(&self) -> bool {
+        false
+    }
+}
+
+impl<F: Fn(u64) + Sync> Progress for F {
+    fn row_done(&self) {
+        self(1)
+    }
 }
 
 // ANCHOR: render
 /// [`render`] into a frame of the scene's size that is already allocated (as
-/// `raystep bench` does, to time the render alone). Once `cancel` is set, no new
-/// row is started and the frame is left unfinished (`raystep serve` cancels a
-/// render that a newer request supersedes).
-pub fn render_into(
-    scene: &Scene,
-    settings: &Settings,
-    frame: &mut Frame,
-    progress: &(dyn Fn(u64) + Sync),
-    cancel: &AtomicBool,
-) {
+/// `raystep bench` does, to time the render alone).
+pub fn render_into(scene: &Scene, settings: &Settings, frame: &mut Frame, progress: &dyn Progress) {
     match settings.precision {
-        Precision::F32 => render_in::<f32>(scene, settings, frame, progress, cancel),
-        Precision::F64 => render_in::<f64>(scene, settings, frame, progress, cancel),
+        Precision::F32 => render_in::<f32>(scene, settings, frame, progress),
+        Precision::F64 => render_in::<f64>(scene, settings, frame, progress),
     }
 }
 // ANCHOR_END: render
@@ -461,13 +464,12 @@ fn render_in<T: Real>(
     scene: &Scene,
     settings: &Settings,
     frame: &mut Frame,
-    progress: &(dyn Fn(u64) + Sync),
-    cancel: &AtomicBool,
+    progress: &dyn Progress,
 ) {
     let tracer = &Tracer::<T>::new(scene, settings);
     let width = tracer.camera.width as usize;
     assert_eq!(frame.pixels.len(), width * tracer.camera.height as usize);
-    let rays = in_rows(frame, width, progress, cancel, |row, line| {
+    let rays = in_rows(frame, width, progress, |row, line| {
         book_row(tracer, settings.spp, row, line)
     });
     frame.describe(scene, tracer, settings, rays);
@@ -475,15 +477,14 @@ fn render_in<T: Real>(
 }
 
 /// The rows of `frame` (`width` pixels each) traced in parallel by `row`, which
-/// fills one row's records and returns the rays they took; `progress(1)` after
-/// each row. After Ctrl-C, or once `cancel` is set, the rows left are skipped
+/// fills one row's records and returns the rays they took, telling `progress` of
+/// each. After Ctrl-C, or once `progress` is cancelled, the rows left are skipped
 /// (and the frame is thrown away). Returns the rays of the whole frame. Both
 /// engines render through it.
 pub fn in_rows(
     frame: &mut Frame,
     width: usize,
-    progress: &(dyn Fn(u64) + Sync),
-    cancel: &AtomicBool,
+    progress: &dyn Progress,
     row: impl Fn(u32, &mut [PixelRecord]) -> Rays + Sync,
 ) -> Rays {
     frame
@@ -491,11 +492,11 @@ pub fn in_rows(
         .par_chunks_mut(width)
         .enumerate()
         .map(|(r, line)| {
-            if crate::interrupt::requested() || cancel.load(Ordering::Relaxed) {
+            if crate::interrupt::requested() || progress.cancelled() {
                 return Rays::default();
             }
             let rays = row(r as u32, line);
-            progress(1);
+            progress.row_done();
             rays
         })
         .reduce(Rays::default, |mut a, b| {

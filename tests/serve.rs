@@ -633,36 +633,46 @@ fn a_render_a_newer_request_of_its_view_supersedes_is_cancelled() {
     assert_eq!(server.get("/api/render?view=a%20b").status, 400);
 }
 
-/// The seam the server cancels through: once the flag is set no row starts,
-/// and the answer is none; never set, the frame is the plain render's.
+/// The seam the server cancels through: once the render's progress says it is
+/// cancelled no row starts; `render_cancellable` answers none for a cancelled
+/// render and, never cancelled, the plain render's frame.
 #[test]
 fn a_cancelled_render_stops_taking_rows() {
     use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+    /// Cancels the render as soon as its first row is finished.
+    struct AfterOneRow {
+        rows: AtomicU64,
+        cancel: AtomicBool,
+    }
+    impl raystep::render::Progress for AfterOneRow {
+        fn row_done(&self) {
+            self.rows.fetch_add(1, Ordering::SeqCst);
+            self.cancel.store(true, Ordering::SeqCst);
+        }
+        fn cancelled(&self) -> bool {
+            self.cancel.load(Ordering::SeqCst)
+        }
+    }
     for engine in [raystep::stages::Engine::Book, raystep::stages::Engine::Fast] {
         let scene = common::seed(64, 400);
         let mut settings: raystep::render::Settings = raystep::stages::Stages::ALL.into();
         settings.engine = engine;
-        let cancel = AtomicBool::new(false);
-        let rows = AtomicU64::new(0);
-        let frame = raystep::engine::render_cancellable(
-            &scene,
-            &settings,
-            &|n| {
-                rows.fetch_add(n, Ordering::SeqCst);
-                cancel.store(true, Ordering::SeqCst);
-            },
-            &cancel,
-        );
-        assert!(frame.is_none(), "{engine:?}");
+        let progress = AfterOneRow {
+            rows: AtomicU64::new(0),
+            cancel: AtomicBool::new(false),
+        };
+        raystep::engine::render(&scene, &settings, &progress);
         // Each thread finishes at most the row it had started.
-        let done = rows.load(Ordering::SeqCst);
+        let done = progress.rows.load(Ordering::SeqCst);
         assert!(
-            done <= rayon::current_num_threads() as u64,
+            (1..=rayon::current_num_threads() as u64).contains(&done),
             "{engine:?}: {done} rows of 400 after the cancel"
         );
+        let cancelled = AtomicBool::new(true);
+        assert!(raystep::engine::render_cancellable(&scene, &settings, &cancelled).is_none());
         let never = AtomicBool::new(false);
-        let whole = raystep::engine::render_cancellable(&scene, &settings, &|_| {}, &never)
-            .expect("finished");
+        let whole =
+            raystep::engine::render_cancellable(&scene, &settings, &never).expect("finished");
         let plain = raystep::engine::render(&scene, &settings, &|_| {});
         assert!(whole.pixels == plain.pixels, "{engine:?}");
     }

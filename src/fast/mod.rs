@@ -17,14 +17,12 @@ pub mod masks;
 pub mod packet;
 pub mod walk;
 
-use std::sync::atomic::AtomicBool;
-
 use crate::aov::{Frame, Packets, PixelRecord, Rays};
 use crate::fast::lanes::{Laned, WIDTH};
 pub use crate::fast::packet::Fast;
 use crate::fast::packet::BATCH;
 use crate::real::Precision;
-use crate::render::{book_row, in_rows, Settings};
+use crate::render::{book_row, in_rows, Progress, Settings};
 use crate::scene::Scene;
 use crate::stages::Engine;
 
@@ -103,15 +101,8 @@ impl<T: Laned> Fast<T> {
 }
 
 /// Render `scene` under `settings` with the fast engine into `frame` (of the
-/// scene's size). `progress(1)` is called, from any thread, each time a row is
-/// finished.
-pub fn render_into(
-    scene: &Scene,
-    settings: &Settings,
-    frame: &mut Frame,
-    progress: &(dyn Fn(u64) + Sync),
-    cancel: &AtomicBool,
-) {
+/// scene's size), telling `progress` of each row finished (from any thread).
+pub fn render_into(scene: &Scene, settings: &Settings, frame: &mut Frame, progress: &dyn Progress) {
     match settings.precision {
         Precision::F32 => render_in(
             &Fast::<f32>::new(scene, settings),
@@ -119,7 +110,6 @@ pub fn render_into(
             settings,
             frame,
             progress,
-            cancel,
         ),
         Precision::F64 => render_in(
             &Fast::<f64>::new(scene, settings),
@@ -127,7 +117,6 @@ pub fn render_into(
             settings,
             frame,
             progress,
-            cancel,
         ),
     }
 }
@@ -138,14 +127,11 @@ fn render_in<T: Laned>(
     scene: &Scene,
     settings: &Settings,
     frame: &mut Frame,
-    progress: &(dyn Fn(u64) + Sync),
-    cancel: &AtomicBool,
+    progress: &dyn Progress,
 ) {
     let width = scene.width as usize;
     assert_eq!(frame.pixels.len(), width * scene.height as usize);
-    let rays = in_rows(frame, width, progress, cancel, |row, line| {
-        fast.row(row, line)
-    });
+    let rays = in_rows(frame, width, progress, |row, line| fast.row(row, line));
     frame.describe(scene, &fast.book, settings, rays);
     frame.engine = Engine::Fast;
     frame.packets = match (fast.packets, fast.avx) {
