@@ -19,7 +19,7 @@ use raystep::ray::Ray;
 use raystep::real::{Real, Vec3Num, Vector};
 use raystep::render::{Settings, Tracer, HALF_STEP};
 use raystep::scene::{Hit, Object, Scene, Shape};
-use raystep::shade::shadow::{step_off, Offset, AUTO_FACTOR};
+use raystep::shade::shadow::{step_off, Offset, SCENE_FACTOR};
 use raystep::shade::{blinn_phong, reflection};
 use raystep::sphere::Method;
 use raystep::stages::{Engine, Stage, Stages};
@@ -1033,8 +1033,8 @@ fn chapter_09_exercise_1_float64_origins_sit_on_the_surface_float32_ones_beside_
     assert!((f32_stuck / 100.0 - inside as f64 / hits as f64).abs() < 0.001);
 }
 
-/// The `auto` step of `src/shade/shadow.rs` with `factor` in place of
-/// `AUTO_FACTOR`.
+/// The `scene` step of `src/shade/shadow.rs` with `factor` in place of
+/// `SCENE_FACTOR`.
 fn step_by<T: Real>(point: T::Vec3, normal: T::Vec3, surface: &Object<T>, factor: f64) -> T::Vec3 {
     let on_surface = surface.surface_point(point, normal);
     let scale = surface.magnitude().max(on_surface.max_abs());
@@ -1182,7 +1182,7 @@ fn failures(factor: f64, cases: usize) -> [usize; 4] {
 
 #[test]
 fn chapter_09_exercise_2_a_factor_of_2_fails_both_properties_in_float64() {
-    // The smallest failing cases proptest prints with AUTO_FACTOR = 2: a sphere
+    // The smallest failing cases proptest prints with SCENE_FACTOR = 2: a sphere
     // of radius 0.55 near the origin, and a plane about 2,800 from it.
     let (centre, radius, origin, aim) = sphere_case(
         0.6000010001677297,
@@ -1224,7 +1224,7 @@ fn chapter_09_exercise_2_a_factor_of_2_fails_both_properties_in_float64() {
         let (near, _) = s.roots_stable(&into).unwrap();
         assert!(near <= 0.0 && outside_exactly(shifted, centre, radius));
     }
-    assert_eq!(sphere(AUTO_FACTOR), Some((true, true)));
+    assert_eq!(sphere(SCENE_FACTOR), Some((true, true)));
     let out = Vec3::new(0.0, 0.0, -0.5187162383817263);
     let (point, normal, origin, target) = plane_case(
         5321.5385778136615,
@@ -1239,18 +1239,18 @@ fn chapter_09_exercise_2_a_factor_of_2_fails_both_properties_in_float64() {
     let plane = |factor| plane_recast::<f64>(point, normal, origin, target, out, factor);
     // "A ray through the plane misses it."
     assert_eq!(plane(2.0), Some((true, false)));
-    assert_eq!(plane(AUTO_FACTOR), Some((true, true)));
+    assert_eq!(plane(SCENE_FACTOR), Some((true, true)));
     // Both fail in float32 too, where it is checked after float64, more rarely.
     let [sphere32, sphere64, plane32, plane64] = failures(2.0, 20_000);
     assert!(sphere64 > 0 && plane64 > 0, "{sphere64}, {plane64}");
     assert!(sphere32 + plane32 > 0);
     assert_eq!(failures(4.0, 20_000), [0; 4], "a factor of 4 passes");
-    assert_eq!(failures(AUTO_FACTOR, 20_000), [0; 4]);
+    assert_eq!(failures(SCENE_FACTOR, 20_000), [0; 4]);
 }
 
 #[test]
 fn the_step_of_chapter_9s_second_exercise_is_the_books_at_its_factor() {
-    // `step_by` is `step_off`'s auto step with the factor as a parameter.
+    // `step_by` is `step_off`'s scene step with the factor as a parameter.
     let scene = scene(&seed());
     let objects = scene.objects_in_play::<f64>(Stages::ALL);
     for row in (0..scene.height).step_by(7) {
@@ -1263,8 +1263,8 @@ fn the_step_of_chapter_9s_second_exercise_is_the_books_at_its_factor() {
             let point = ray.at(hit.t);
             let normal = object.normal_at(point, &ray);
             assert_eq!(
-                step_by(point, normal, object, AUTO_FACTOR),
-                step_off(point, normal, object, Offset::Auto)
+                step_by(point, normal, object, SCENE_FACTOR),
+                step_off(point, normal, object, Offset::Scene)
             );
         }
     }

@@ -518,7 +518,9 @@ fn help_states_every_limit_with_the_numbers_the_code_uses() {
         format!("1 to {MAX_DEPTH} segments"),
         format!("from 1 to {MAX_SPP}"),
         format!("at most {MAX_MAGNITUDE:e} in magnitude"),
-        format!("a radius at least {MIN_RADIUS:e} and\n                 {MIN_RADIUS_RATIO:e} of"),
+        format!(
+            "a radius at least {MIN_RADIUS:e} and\n                 {MIN_RADIUS_RATIO_F64:.1e} of the scene's size ({MIN_RADIUS_RATIO:e} with --precision f32)"
+        ),
         format!("at most {} MiB", MAX_FILE_BYTES / (1024 * 1024)),
         format!(
             "fits in {gigabytes}: about {}\n                 bytes per sphere",

@@ -62,7 +62,7 @@ use crate::scene::{on_plane, on_sphere};
 use crate::scene::{Light, Object, Scene, Shape};
 use crate::shade::blinn_phong::{factors, whole_exponent, Viewer};
 use crate::shade::reflection::reflect;
-use crate::shade::shadow::{step_out, Offset};
+use crate::shade::shadow::{step_out, step_out_by_scene, Offset};
 use crate::sphere::outward_normal;
 use crate::sphere::Method;
 use crate::stages::Stage;
@@ -988,7 +988,7 @@ impl<T: Laned> Fast<T> {
     ) -> V3<T> {
         match self.book.offset {
             Offset::Fixed(step) => point + normal.scale(T::Lanes::splat(T::of(step))),
-            Offset::Auto => {
+            Offset::Auto | Offset::Scene => {
                 let shape = &object.shape;
                 let spheres = shape.spheres & alive;
                 let sphere = || on_sphere(shape.point, normal, object.radius);
@@ -1003,7 +1003,10 @@ impl<T: Laned> Fast<T> {
                     }
                 };
                 let u = T::Lanes::splat(T::UNIT_ROUNDOFF);
-                step_out(on_surface, normal, object.magnitude, u)
+                match self.book.offset {
+                    Offset::Scene => step_out_by_scene(on_surface, normal, object.magnitude, u),
+                    _ => step_out(on_surface, normal, shape.point, u),
+                }
             }
         }
     }

@@ -12,6 +12,7 @@ use serde::Deserialize;
 use crate::camera::Screen;
 use crate::error::Error;
 use crate::plane::Plane;
+use crate::real::Precision;
 use crate::scene::{Light, Material, Object, Role, Scene, Shape};
 use crate::sphere::Sphere;
 use crate::Vec3;
@@ -40,9 +41,22 @@ pub use crate::scene::MAX_MAGNITUDE;
 /// Smallest accepted radius of a sphere.
 pub const MIN_RADIUS: f64 = 1e-12;
 
-/// Smallest accepted radius of a sphere, as a fraction of the largest coordinate
-/// of its center and of the camera (float32 rounds a coordinate by 6e-8 of it).
+/// Smallest radius of a sphere float32 resolves, as a fraction of the largest
+/// coordinate of its center and of the camera: float32 rounds a coordinate by
+/// 6e-8 of it (its unit roundoff u), so this is about 17u. A scene below it is
+/// refused only when float32 is asked for ([`check_precision`]).
 pub const MIN_RADIUS_RATIO: f64 = 1e-6;
+
+/// The same limit in float64: the same 17 or so unit roundoffs, of float64's
+/// unit roundoff (1.1e-16 instead of 6e-8), so 1.9e-15. The loader checks
+/// scenes against it; float64 renders a scene at this limit as well as float32
+/// renders one at [`MIN_RADIUS_RATIO`].
+pub const MIN_RADIUS_RATIO_F64: f64 = MIN_RADIUS_RATIO * (f64::EPSILON / f32::EPSILON as f64);
+
+/// The widest terminator float32 may leave before [`check_precision`] warns: the
+/// `auto` step makes a shadow ray start a height `h` above its sphere, and it
+/// passes over it for `|L·N|` below about `√(2h/r)`.
+pub const F32_TERMINATOR_WARNING: f64 = 1e-2;
 
 /// Largest accepted `max_depth`.
 pub const MAX_DEPTH: u32 = 64;
@@ -624,16 +638,17 @@ impl SceneFile {
         .map(f64::abs)
         .into_iter()
         .fold(0.0, f64::max);
-        let nearest = least_length(size);
+        let nearest = least_length(size, MIN_RADIUS_RATIO_F64);
         if camera.z.abs() < nearest {
             return Err(format!(
                 "camera.position: z = {} puts the eye too near the screen, which lies in the \
-                 plane z = 0: it must be at least {} away ({MIN_RADIUS_RATIO:e} × {}, the \
+                 plane z = 0: it must be at least {} away ({} × {}, the \
                  largest coordinate of the screen's edges and the camera's x and y, and at \
                  least {MIN_RADIUS:e}), or rays to the screen have no direction; e.g. \
                  position = [0, 0, 1]",
                 shown(camera.z),
                 shown(nearest),
+                ratio_shown(MIN_RADIUS_RATIO_F64),
                 shown(size)
             ));
         }
@@ -652,7 +667,7 @@ impl SceneFile {
         for (i, keys) in self.sphere.into_iter().enumerate() {
             let at = format!("[[sphere]] number {}", i + 1);
             let shape = sphere(keys.center, keys.radius, &at)?;
-            placed(&shape, &at, camera, light.position)?;
+            placed(&shape, &at, camera, light.position, MIN_RADIUS_RATIO_F64)?;
             objects.push(Object {
                 shape: Shape::Sphere(shape),
                 material: material_keys!(keys).check(&at)?,
@@ -663,8 +678,16 @@ impl SceneFile {
             let at = format!("[[plane]] number {}", i + 1);
             let shape = keys.shape(&at)?;
             match &shape {
-                Shape::Sphere(s) => placed(s, &format!("{at} (a sphere)"), camera, light.position)?,
-                Shape::Plane(plane) => lit_from_off(plane, &at, light.position)?,
+                Shape::Sphere(s) => placed(
+                    s,
+                    &format!("{at} (a sphere)"),
+                    camera,
+                    light.position,
+                    MIN_RADIUS_RATIO_F64,
+                )?,
+                Shape::Plane(plane) => {
+                    lit_from_off(plane, &at, light.position, MIN_RADIUS_RATIO_F64)?
+                }
             }
             objects.push(Object {
                 shape,
@@ -815,39 +838,48 @@ fn colour(value: Option<Triple>, default: Vec3, key: &str) -> Result<Vec3, Strin
     Ok(c)
 }
 
-/// The least length (a radius, the camera's distance from the screen) that float32
-/// resolves among coordinates up to `size`: [`MIN_RADIUS_RATIO`] of it, and at least
-/// [`MIN_RADIUS`].
-fn least_length(size: f64) -> f64 {
-    (MIN_RADIUS_RATIO * size).max(MIN_RADIUS)
+/// The least length (a radius, the camera's distance from the screen) that a
+/// precision resolves among coordinates up to `size`: `ratio` of it
+/// ([`MIN_RADIUS_RATIO`] in float32, [`MIN_RADIUS_RATIO_F64`] in float64), and at
+/// least [`MIN_RADIUS`].
+fn least_length(size: f64, ratio: f64) -> f64 {
+    (ratio * size).max(MIN_RADIUS)
 }
 
 /// Refuse a sphere too small for its place in the scene, and a camera or a light
 /// inside (or on) it.
 ///
-/// - Its radius must be at least [`MIN_RADIUS`], and at least [`MIN_RADIUS_RATIO`]
-///   times the largest coordinate of its center and of the camera: below that,
-///   float32's rounding of a hit point is as large as the sphere, a hit point can
-///   land on the center, and its normal has no direction.
+/// - Its radius must be at least [`MIN_RADIUS`], and at least `ratio` times the
+///   largest coordinate of its center and of the camera (`ratio` is
+///   [`MIN_RADIUS_RATIO`] for float32, [`MIN_RADIUS_RATIO_F64`] for float64):
+///   below that, the precision's rounding of a hit point is a sizeable part of
+///   the sphere, a hit point can land on the center, and its normal has no
+///   direction.
 /// - The tutorial's spheres are solid and shaded from outside: a camera inside
 ///   sees only the wall, lit as if from outside, and a light inside would leave
 ///   every other point in the sphere's shadow. "On" allows for rounding: within
-///   [`MIN_RADIUS_RATIO`] of the scene's size of the surface.
-fn placed(s: &Sphere, at: &str, camera: Vec3, light: Vec3) -> Result<(), String> {
+///   `ratio` of the scene's size of the surface.
+fn placed(s: &Sphere, at: &str, camera: Vec3, light: Vec3, ratio: f64) -> Result<(), String> {
     let size = s.center.abs().max_element().max(camera.abs().max_element());
-    let smallest = least_length(size);
+    let smallest = least_length(size, ratio);
     if s.radius < smallest {
+        let precision = if ratio == MIN_RADIUS_RATIO {
+            "float32"
+        } else {
+            "float64"
+        };
         return Err(format!(
-            "{at}, radius: {} is smaller than {}, the least raystep accepts here \
-             ({MIN_RADIUS_RATIO:e} × {}, the largest coordinate of its center and of the \
-             camera, and at least {MIN_RADIUS:e}): float32 would round its hit points by more \
-             than its size; make it larger or scale the whole scene",
+            "{at}, radius: {} is smaller than {}, the least raystep accepts here in \
+             {precision} ({} × {}, the largest coordinate of its center and of the \
+             camera, and at least {MIN_RADIUS:e}): {precision} would round its hit points by \
+             a sizeable part of its size; make it larger or scale the whole scene",
             shown(s.radius),
             shown(smallest),
+            ratio_shown(ratio),
             shown(size)
         ));
     }
-    let margin = MIN_RADIUS_RATIO * size.max(s.radius);
+    let margin = ratio * size.max(s.radius);
     let inside = |p: Vec3| (p - s.center).length() <= s.radius + margin;
     let described = format!(
         "{at} (center {}, radius {})",
@@ -871,15 +903,15 @@ fn placed(s: &Sphere, at: &str, camera: Vec3, light: Vec3) -> Result<(), String>
     Ok(())
 }
 
-/// Refuse a light on a true plane (within [`MIN_RADIUS_RATIO`] of the scene's size
-/// of it): the plane would be lit edge-on, and a point of it could be the light
-/// itself, from which no direction leads to the light.
-fn lit_from_off(plane: &Plane, at: &str, light: Vec3) -> Result<(), String> {
+/// Refuse a light on a true plane (within `ratio` of the scene's size of it): the
+/// plane would be lit edge-on, and a point of it could be the light itself, from
+/// which no direction leads to the light.
+fn lit_from_off(plane: &Plane, at: &str, light: Vec3, ratio: f64) -> Result<(), String> {
     let size = light
         .abs()
         .max_element()
         .max(plane.point.abs().max_element());
-    if (light - plane.point).dot(plane.normal).abs() <= MIN_RADIUS_RATIO * size {
+    if (light - plane.point).dot(plane.normal).abs() <= ratio * size {
         return Err(format!(
             "light.position {} lies on {at}: the plane would be lit edge-on, and the light \
              would be a point of it; move the light off the plane",
@@ -887,6 +919,108 @@ fn lit_from_off(plane: &Plane, at: &str, light: Vec3) -> Result<(), String> {
         ));
     }
     Ok(())
+}
+
+/// Check a loaded scene (the loader checked it for float64) against what
+/// `precision` resolves. In float64: nothing more. In float32: the loader's
+/// limits again with [`MIN_RADIUS_RATIO`] (an error, naming float64 as the way
+/// out), and warnings for what float32 renders but coarsely: a sphere whose
+/// shadow edge is uncertain beyond [`F32_TERMINATOR_WARNING`], and spheres that
+/// float32 makes one.
+pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String>, String> {
+    if precision == Precision::F64 {
+        return Ok(Vec::new());
+    }
+    let to_f64 = "; float64 (the default precision, --precision f64) renders it";
+    let edges = scene.camera().screen;
+    let size = [
+        scene.camera.x,
+        scene.camera.y,
+        edges.left,
+        edges.right,
+        edges.top,
+        edges.bottom,
+    ]
+    .map(f64::abs)
+    .into_iter()
+    .fold(0.0, f64::max);
+    if scene.camera.z.abs() < least_length(size, MIN_RADIUS_RATIO) {
+        return Err(format!(
+            "camera.position: z = {} puts the eye too near the screen for float32 \
+             (at least {MIN_RADIUS_RATIO:e} × {}){to_f64}",
+            shown(scene.camera.z),
+            shown(size)
+        ));
+    }
+    let light = scene.light.position;
+    let mut warnings = Vec::new();
+    let mut spheres = Vec::new();
+    for (i, object) in scene.objects.iter().enumerate() {
+        let at = format!("object number {} ({})", i + 1, describe(object));
+        match &object.shape {
+            Shape::Sphere(s) => {
+                placed(s, &at, scene.camera, light, MIN_RADIUS_RATIO)
+                    .map_err(|e| format!("{e}{to_f64}"))?;
+                let band = f32_terminator(s);
+                if band > F32_TERMINATOR_WARNING {
+                    let far = s.center + s.center.normalize_or(Vec3::X) * s.radius;
+                    let step = crate::tools::accuracy::auto_step(
+                        f64::from(f32::EPSILON) / 2.0,
+                        s.radius,
+                        far,
+                    );
+                    warnings.push(format!(
+                        "{at}: its centre is {:.1e} radii from the origin; float32 places its \
+                         points to within {step:.1e} ({:.2} of its radius), so shadow rays \
+                         start that far out and its shadow's edge is uncertain up to \
+                         |L·N| = {band:.2}; float64 (the default precision) renders it to 1e-3",
+                        s.center.length() / s.radius,
+                        step / s.radius,
+                    ));
+                }
+                let rounded = (s.center.as_vec3(), s.radius as f32);
+                if let Some(j) = spheres
+                    .iter()
+                    .position(|(other, _): &((glam::Vec3, f32), Sphere)| *other == rounded)
+                {
+                    warnings.push(format!(
+                        "{at} is object number {} in float32 (their centres and radii round to \
+                         the same numbers), so the first of the two is drawn; float64 (the \
+                         default precision) tells them apart",
+                        j + 1
+                    ));
+                }
+                spheres.push((rounded, *s));
+            }
+            Shape::Plane(plane) => lit_from_off(plane, &at, light, MIN_RADIUS_RATIO)
+                .map_err(|e| format!("{e}{to_f64}"))?,
+        }
+    }
+    Ok(warnings)
+}
+
+/// The terminator band float32 leaves on sphere `s` at its point farthest from
+/// the origin (see [`crate::tools::accuracy::terminator_band`]).
+fn f32_terminator(s: &Sphere) -> f64 {
+    let far = s.center + s.center.normalize_or(Vec3::X) * s.radius;
+    crate::tools::accuracy::terminator_band(f64::from(f32::EPSILON) / 2.0, s.radius, far)
+}
+
+/// An object as messages name it.
+fn describe(object: &Object) -> String {
+    match &object.shape {
+        Shape::Sphere(s) => format!(
+            "a sphere, center {}, radius {}",
+            vector(s.center),
+            shown(s.radius)
+        ),
+        Shape::Plane(p) => format!("a plane through {}", vector(p.point)),
+    }
+}
+
+/// A limit's ratio as messages show it: `1e-6`, `1.9e-15`.
+fn ratio_shown(ratio: f64) -> String {
+    format!("{ratio:.1e}").replace(".0e", "e")
 }
 
 /// `[x, y, z]` as a scene file writes it.

@@ -9,17 +9,25 @@ use crate::sphere::Method;
 /// ray from it.
 pub const TUTORIAL_STEP: f64 = 1e-5;
 
-/// The `auto` offset steps out by this many unit roundoffs of the size of the
-/// numbers the surface is computed from. It has to cover the error of the point put
-/// back on the surface and the error of the next ray's first root, a few units
-/// each. Measured with the property tests `a_stepped_off_origin_is_outside_its_sphere_at_any_scale`
-/// and `a_ray_leaving_a_plane_never_meets_it_again_at_any_scale` (`tests/accuracy.rs`,
-/// `RAYSTEP_PROPTEST_CASES=20000`, scales 1e-3 to 1e4): a factor of 1 fails in
-/// float32, 2 fails in float64, 4 passes; 8 leaves a margin of 2. A larger factor
-/// costs accuracy the other way: shadow rays start too far out and pass over their
-/// own sphere at the terminator (in float32, a step about four times this one gave
-/// 6.55 % wrong shadows on `scenes/stress/far-sphere.toml`, against 3.42 %).
-pub const AUTO_FACTOR: f64 = 8.0;
+/// The `scene` offset (raystep's `auto` before the bound below) steps out by this
+/// many unit roundoffs of the size of the numbers the surface is computed from,
+/// the largest coordinate of its centre (or anchor) plus its radius. Kept to be
+/// measured against (`--offset scene`): it is right at every scale, but for a
+/// sphere far from the origin compared with its radius it is a sizeable part of
+/// the radius (8·u·(|C| + r) is half the radius of a sphere of radius 1e-3 at 1000
+/// in float32), and shadow rays that start that far out pass over their own
+/// sphere near the terminator.
+pub const SCENE_FACTOR: f64 = 8.0;
+
+/// Unit roundoffs of the distance from the surface's anchor (a sphere's centre,
+/// a plane's point) in the `auto` step: the bound derived at [`step_out`] is 9.5
+/// for a sphere and 8 for a plane, to first order.
+pub const ANCHOR_UNITS: f64 = 10.0;
+
+/// Unit roundoffs of the distance of the point from the origin in the `auto`
+/// step: the bound derived at [`step_out`] is 2, to first order; the third
+/// covers the terms of second order and the rounding of the bound itself.
+pub const ORIGIN_UNITS: f64 = 3.0;
 
 /// How far a hit point is moved along the normal before a shadow or reflected ray
 /// leaves it (`--offset`).
@@ -27,8 +35,13 @@ pub const AUTO_FACTOR: f64 = 8.0;
 pub enum Offset {
     /// A fixed distance, whatever the scene's scale: `fixed:1e-5` is the tutorial's.
     Fixed(f64),
-    /// Put the point back on the surface, then step out by a bound of its rounding
-    /// error, which grows with the size of the numbers involved: right at every scale.
+    /// Put the point back on the surface, then step out by [`SCENE_FACTOR`] unit
+    /// roundoffs of the size of the surface's numbers (raystep's first automatic
+    /// offset, kept for comparison).
+    Scene,
+    /// Put the point back on the surface, then step out by a bound of the error
+    /// of that point and of the next ray's test ([`step_out`]): a few unit
+    /// roundoffs of the radius and of the point's distance from the origin.
     #[default]
     Auto,
 }
@@ -41,14 +54,16 @@ impl Offset {
 impl std::str::FromStr for Offset {
     type Err = String;
 
-    /// `auto`, or `fixed:VALUE` with VALUE from 0 to 1e15 (e.g. `fixed:1e-5`).
+    /// `auto`, `scene`, or `fixed:VALUE` with VALUE from 0 to 1e15 (e.g. `fixed:1e-5`).
     fn from_str(text: &str) -> Result<Offset, String> {
-        if text == "auto" {
-            return Ok(Offset::Auto);
+        match text {
+            "auto" => return Ok(Offset::Auto),
+            "scene" => return Ok(Offset::Scene),
+            _ => {}
         }
-        let value = text
-            .strip_prefix("fixed:")
-            .ok_or_else(|| format!("`{text}`: expected auto or fixed:VALUE, e.g. fixed:1e-5"))?;
+        let value = text.strip_prefix("fixed:").ok_or_else(|| {
+            format!("`{text}`: expected auto, scene or fixed:VALUE, e.g. fixed:1e-5")
+        })?;
         match value.parse::<f64>() {
             Ok(v) if (0.0..=crate::scene::MAX_MAGNITUDE).contains(&v) => Ok(Offset::Fixed(v)),
             _ => Err(format!(
@@ -64,6 +79,7 @@ impl std::fmt::Display for Offset {
         match self {
             Offset::Fixed(v) if *v == 0.0 => f.write_str("fixed:0"),
             Offset::Fixed(v) => write!(f, "fixed:{v:e}"),
+            Offset::Scene => f.write_str("scene"),
             Offset::Auto => f.write_str("auto"),
         }
     }
@@ -80,26 +96,74 @@ pub fn step_off<T: Real>(
     surface: &Object<T>,
     offset: Offset,
 ) -> T::Vec3 {
+    let u = T::UNIT_ROUNDOFF;
     match offset {
         Offset::Fixed(step) => point + normal * T::of(step),
-        Offset::Auto => {
+        Offset::Auto => step_out(
+            surface.surface_point(point, normal),
+            normal,
+            surface.anchor(),
+            u,
+        ),
+        Offset::Scene => {
             let on_surface = surface.surface_point(point, normal);
-            step_out(on_surface, normal, surface.magnitude(), T::UNIT_ROUNDOFF)
+            step_out_by_scene(on_surface, normal, surface.magnitude(), u)
         }
     }
 }
 
-/// The `auto` step: from a point computed to be on a surface whose numbers are of
-/// size `magnitude`, out along the unit `normal` by `AUTO_FACTOR` unit roundoffs
-/// `u` of the larger of that size and the point's. (For any [`Vec3Num`]: the fast
-/// engine steps four points at once with this body.)
+/// The `auto` step: from a point `on_surface` just put back on a surface (a
+/// sphere's `C + N·r`, a plane's `p − n·⟨p − P, n⟩`), out along the unit `normal`
+/// by a bound of what rounding can do to it, with `u` the unit roundoff:
+///
+/// `h = u·(10·‖S − A‖ + 3·‖S‖)`, with `S` the point on the surface and `A` the
+/// surface's anchor (a sphere's centre, so `‖S − A‖` is the radius `r`; a
+/// plane's point).
+///
+/// Why. Every operation is exact up to a factor `1 + δ`, `|δ| ≤ u` (Higham's
+/// model; `γ_n = n·u/(1 − n·u)` bounds `n` such factors). Follow a sphere's
+/// point through, measuring heights along the normal:
+///
+/// 1. `N = (P − C)·(1/‖P − C‖)` is a unit vector up to `‖N‖ = 1 ± 4.5u` (three
+///    squares summed, a square root, a reciprocal, a product), so `C + N·r`
+///    is `4.5u·r` off the sphere before it is rounded; pbrt-v4 bounds its
+///    re-projected sphere point by `γ_5·|p|` for the same reason.
+/// 2. `N·r` and `C + N·r` are rounded: `u·r` and `u·‖S‖` more along the normal.
+/// 3. The step `S + N·h` is rounded too: `u·‖S‖` (and `u·h`).
+/// 4. The next ray's test must see the origin outside: it computes
+///    `c = ‖C − O‖² − r²` and counts the sphere only if `c > 0`. Rounding of
+///    `C − O`, of the sum of squares (`γ_3`) and of `r²` can turn a true `c > 0`
+///    negative unless `‖C − O‖ > r·(1 + 3u)`: `3u·r` more.
+///
+/// So the origin is outside, as the next test sees it, once
+/// `h > 9.5u·r + 2u·‖S‖` (to first order in `u`). A plane's point, followed the
+/// same way, needs `h > 8u·‖S − P‖ + 2u·‖S‖`: the dot product `⟨S − P, n⟩` is
+/// where its error grows with the distance from the anchor, once when the point
+/// is projected and once in the next test. `h` rounds both up.
+///
+/// Nothing here is the size of the scene: a sphere far from the origin steps
+/// out by `3u` of its distance (the spacing of the numbers there, which no
+/// method can beat), not by a multiple of its largest coordinate, and `‖S‖` is
+/// at most the ray's origin plus the distance it travelled, `‖O‖ + t`. (For
+/// any [`Vec3Num`]: the fast engine steps four points at once with this body.)
 #[inline(always)]
-pub fn step_out<V: Vec3Num>(on_surface: V, normal: V, magnitude: V::Num, u: V::Num) -> V {
-    let scale = magnitude.max(on_surface.max_abs());
-    let bound = V::Num::of(AUTO_FACTOR) * u * scale;
+pub fn step_out<V: Vec3Num>(on_surface: V, normal: V, anchor: V, u: V::Num) -> V {
+    let from_anchor = (on_surface - anchor).length();
+    let bound = u
+        * (V::Num::of(ANCHOR_UNITS) * from_anchor + V::Num::of(ORIGIN_UNITS) * on_surface.length());
     on_surface + normal * bound
 }
 // ANCHOR_END: step_off
+
+/// The `scene` step: out along the unit `normal` by [`SCENE_FACTOR`] unit
+/// roundoffs `u` of the larger of the surface's `magnitude` and the point's
+/// largest coordinate. (For any [`Vec3Num`], as the fast engine computes it.)
+#[inline(always)]
+pub fn step_out_by_scene<V: Vec3Num>(on_surface: V, normal: V, magnitude: V::Num, u: V::Num) -> V {
+    let scale = magnitude.max(on_surface.max_abs());
+    let bound = V::Num::of(SCENE_FACTOR) * u * scale;
+    on_surface + normal * bound
+}
 
 // ANCHOR: in_shadow
 /// The tutorial's shadow test: cast a ray from the moved point `shifted` towards the
@@ -131,6 +195,8 @@ mod tests {
         assert_eq!("fixed:1e-5".parse(), Ok(Offset::Fixed(1e-5)));
         assert_eq!("fixed:0".parse(), Ok(Offset::Fixed(0.0)));
         assert_eq!("auto".parse(), Ok(Offset::Auto));
+        assert_eq!("scene".parse(), Ok(Offset::Scene));
+        assert_eq!(Offset::Scene.to_string(), "scene");
         assert_eq!(Offset::TUTORIAL.to_string(), "fixed:1e-5");
         assert_eq!(Offset::default().to_string(), "auto");
         assert_eq!(Offset::Fixed(0.0).to_string(), "fixed:0");
@@ -139,6 +205,6 @@ mod tests {
         assert!("1e-5"
             .parse::<Offset>()
             .unwrap_err()
-            .contains("expected auto or fixed:VALUE"));
+            .contains("expected auto, scene or fixed:VALUE"));
     }
 }

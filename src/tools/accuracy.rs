@@ -45,6 +45,55 @@ pub const CASES: &[(&str, &str)] = &[
     ),
     ("contact", include_str!("../../scenes/stress/contact.toml")),
     ("graze", include_str!("../../scenes/stress/graze.toml")),
+    (
+        "tiny-far",
+        include_str!("../../scenes/stress/tiny-far.toml"),
+    ),
+    (
+        "graze-row",
+        include_str!("../../scenes/stress/graze-row.toml"),
+    ),
+    (
+        "horizon-low-light",
+        include_str!("../../scenes/stress/horizon-low-light.toml"),
+    ),
+    (
+        "seed-moved-9e4",
+        include_str!("../../scenes/stress/seed-moved-9e4.toml"),
+    ),
+    (
+        "seed-moved-1e5",
+        include_str!("../../scenes/stress/seed-moved-1e5.toml"),
+    ),
+    (
+        "seed-x10000",
+        include_str!("../../scenes/stress/seed-x10000.toml"),
+    ),
+    (
+        "seed-x0.0001",
+        include_str!("../../scenes/stress/seed-x0.0001.toml"),
+    ),
+    (
+        "camera-far",
+        include_str!("../../scenes/stress/camera-far.toml"),
+    ),
+    (
+        "touching",
+        include_str!("../../scenes/stress/touching.toml"),
+    ),
+    ("twins", include_str!("../../scenes/stress/twins.toml")),
+    (
+        "nested-mirror",
+        include_str!("../../scenes/stress/nested-mirror.toml"),
+    ),
+    (
+        "light-above",
+        include_str!("../../scenes/stress/light-above.toml"),
+    ),
+    (
+        "plane-far",
+        include_str!("../../scenes/stress/plane-far.toml"),
+    ),
 ];
 
 /// A stress scene by name.
@@ -58,12 +107,55 @@ pub fn case(name: &str) -> Option<Scene> {
 
 /// Pixels whose ray passes within this fraction of a sphere's radius of its
 /// silhouette are not judged hit or miss: there the answer depends on the last
-/// bit of the ray itself.
+/// bit of the ray itself. In float32 the band is wider ([`silhouette_band`]).
 pub const SILHOUETTE_BAND: f64 = 1e-9;
 
+/// Unit roundoffs of `‖O‖ + ‖C‖ + r + t` in the silhouette band of the precision
+/// under test: the ray's origin and direction, the centre and the radius it is
+/// tested against are all rounded to numbers of that size, so float32 cannot
+/// place a ray's closest approach to a sphere better than a few of those units.
+pub const SILHOUETTE_UNITS: f64 = 8.0;
+
 /// Hit points whose light direction is within this of the tangent plane
-/// (|L·N| below it) are not judged lit or shadowed: the terminator.
+/// (|L·N| below it) are not judged lit or shadowed: the terminator. On a sphere
+/// the band is wider where the `auto` step is a sizeable part of the radius
+/// ([`terminator_band`]).
 pub const TERMINATOR_BAND: f64 = 1e-3;
+
+/// The width, in scene units, of the band around a sphere's silhouette in which a
+/// ray is not judged, for a ray from `origin` computed with unit roundoff `u`:
+/// [`SILHOUETTE_BAND`] of the radius in float64, and in float32 also
+/// [`SILHOUETTE_UNITS`]` · u · (‖O‖ + ‖C‖ + r + t)` with `t` the distance to the
+/// centre.
+pub fn silhouette_band(u: f64, origin: Vec3, s: &Sphere) -> f64 {
+    let relative = SILHOUETTE_BAND * s.radius;
+    if u < f64::from(f32::EPSILON) / 4.0 {
+        return relative;
+    }
+    let t = origin.distance(s.center);
+    let sizes = origin.length() + s.center.length() + s.radius + t;
+    relative.max(SILHOUETTE_UNITS * u * sizes)
+}
+
+/// The `auto` step at a point `on_surface` of a surface of radius `radius`
+/// (for a plane: the distance from its anchor), in unit roundoffs `u`: the
+/// formula of [`crate::shade::shadow::step_out`].
+pub fn auto_step(u: f64, radius: f64, on_surface: Vec3) -> f64 {
+    use crate::shade::shadow::{ANCHOR_UNITS, ORIGIN_UNITS};
+    u * (ANCHOR_UNITS * radius + ORIGIN_UNITS * on_surface.length())
+}
+
+/// The terminator band at a point `on_surface` of a sphere of radius `radius`,
+/// for a precision of unit roundoff `u`: a shadow ray that starts a height `h`
+/// above a sphere and enters it at `|L·N| = s` passes over it when
+/// `(r + h)·√(1 − s²) > r`, that is for `s` below about `√(2h/r)`. With `h` the
+/// `auto` step, which no offset that keeps origins outside can undercut by more
+/// than a small factor, the band is the larger of [`TERMINATOR_BAND`] and that.
+/// In float64 it is [`TERMINATOR_BAND`] for any sphere within 1e9 radii of the
+/// origin; in float32 `√(2h/r)` is at least `√(20u)` = 1.1e-3.
+pub fn terminator_band(u: f64, radius: f64, on_surface: Vec3) -> f64 {
+    TERMINATOR_BAND.max((2.0 * auto_step(u, radius, on_surface) / radius).sqrt())
+}
 
 /// What one configuration gets wrong on one scene.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -74,8 +166,12 @@ pub struct Measure {
     pub precision: String,
     /// `naive` or `stable`.
     pub method: String,
-    /// `fixed:…` or `auto`.
+    /// `fixed:…`, `scene` or `auto`.
     pub offset: String,
+    /// What the loader says of this scene in this precision: `ok`, `warned`
+    /// (rendered, with a warning: float32 resolves its shadow edges only coarsely)
+    /// or `refused` (measured anyway; `raystep render` refuses it in float32).
+    pub limit: String,
     /// Pixels in the image.
     pub pixels: usize,
     /// Pixels judged for hit or miss (outside the silhouette band).
@@ -86,6 +182,11 @@ pub struct Measure {
     pub false_hits: usize,
     /// Pixels that miss where the reference hits.
     pub false_misses: usize,
+    /// `false_hits` and `false_misses` judged with the narrow band of float64
+    /// ([`SILHOUETTE_BAND`] of the radius) whatever the precision: in float32
+    /// this counts the failures inside float32's own band too (the textbook
+    /// quadratic's on `graze`).
+    pub strict_false: (usize, usize),
     /// The largest distance of a first hit point from its surface, in scene units.
     pub max_surface_error: f64,
     /// The largest of each hit's distance from its surface divided by the unit
@@ -98,6 +199,11 @@ pub struct Measure {
     /// Fraction of judged first hits whose shadow verdict differs from the
     /// reference's: the acne (or the light leaks) that shows.
     pub wrong_shadow: f64,
+    /// Wrong shadow verdicts, counted (the numerator of `wrong_shadow`).
+    pub wrong_shadows: usize,
+    /// The largest |L·N| at a wrong shadow verdict (0 if there is none): how far
+    /// from the terminator the failures reach.
+    pub worst_facing: f64,
 }
 
 /// Measure one configuration on one scene (every stage on).
@@ -120,11 +226,17 @@ pub fn measure(
         Precision::F64 => measure_in::<f64>(scene, &settings),
     };
     m.case = name.to_string();
+    m.limit = match crate::io::scene_file::check_precision(scene, precision) {
+        Err(_) => "refused",
+        Ok(warnings) if !warnings.is_empty() => "warned",
+        Ok(_) => "ok",
+    }
+    .to_string();
     m
 }
 
 /// Every stress case × precision × method × offset (fixed:0, the tutorial's
-/// fixed:1e-5, auto).
+/// fixed:1e-5, scene, auto).
 pub fn measure_all() -> Vec<Measure> {
     CASES
         .iter()
@@ -140,7 +252,12 @@ pub fn measure_case(name: &str) -> Vec<Measure> {
     let mut rows = Vec::new();
     for precision in [Precision::F32, Precision::F64] {
         for method in [Method::Naive, Method::Stable] {
-            for offset in [Offset::Fixed(0.0), Offset::TUTORIAL, Offset::Auto] {
+            for offset in [
+                Offset::Fixed(0.0),
+                Offset::TUTORIAL,
+                Offset::Scene,
+                Offset::Auto,
+            ] {
                 rows.push(measure(name, &scene, precision, method, offset));
             }
         }
@@ -157,16 +274,21 @@ fn measure_in<T: Real>(scene: &Scene, settings: &Settings) -> Measure {
         precision: T::NAME.to_string(),
         method: settings.method.to_string(),
         offset: settings.offset.to_string(),
+        limit: String::new(),
         pixels: (scene.width * scene.height) as usize,
         judged: 0,
         reference_hits: 0,
         false_hits: 0,
         false_misses: 0,
+        strict_false: (0, 0),
         max_surface_error: 0.0,
         max_surface_error_ulps: 0.0,
         stuck: 0.0,
         wrong_shadow: 0.0,
+        wrong_shadows: 0,
+        worst_facing: 0.0,
     };
+    let u = T::UNIT_ROUNDOFF.to_f64();
     let (mut first_hits, mut stuck, mut shadow_judged, mut wrong) =
         (0usize, 0usize, 0usize, 0usize);
     for row in 0..scene.height {
@@ -177,8 +299,19 @@ fn measure_in<T: Real>(scene: &Scene, settings: &Settings) -> Measure {
                 direction: ray.direction.to_f64(),
             };
             let traced = tracer.trace(ray, &mut ());
-            let truth = reference_hit(&reference, &exact_ray);
+            let truth = reference_hit(&reference, &exact_ray, u);
 
+            if let Some(strict) = reference_hit(&reference, &exact_ray, 0.0) {
+                match (traced.first.map(|f| f.object), strict.hit) {
+                    (Some(_), None) => m.strict_false.0 += 1,
+                    (None, Some(_)) => m.strict_false.1 += 1,
+                    (Some(a), Some(b)) if a != b => {
+                        m.strict_false.0 += 1;
+                        m.strict_false.1 += 1;
+                    }
+                    _ => {}
+                }
+            }
             if let Some(truth) = truth {
                 match (traced.first.map(|f| f.object), truth.hit) {
                     (Some(_), None) => m.false_hits += 1,
@@ -203,7 +336,15 @@ fn measure_in<T: Real>(scene: &Scene, settings: &Settings) -> Measure {
             let exact_object = &reference[first.object];
             let error = surface_distance(exact_object, point.to_f64()).abs();
             m.max_surface_error = m.max_surface_error.max(error);
-            let ulps = error / (T::UNIT_ROUNDOFF.to_f64() * exact_object.magnitude());
+            // (A plane through the origin has magnitude 0: its points' own size
+            // stands in.)
+            let size = exact_object.magnitude();
+            let size = if size > 0.0 {
+                size
+            } else {
+                point.to_f64().length()
+            };
+            let ulps = error / (T::UNIT_ROUNDOFF.to_f64() * size);
             m.max_surface_error_ulps = m.max_surface_error_ulps.max(ulps);
             // Is the stepped-off origin outside the surface?
             let shifted = step_off(point, T::Vec3::of(first.normal), object, settings.offset);
@@ -217,18 +358,20 @@ fn measure_in<T: Real>(scene: &Scene, settings: &Settings) -> Measure {
             }
             // Is the shadow verdict the reference's?
             let facing = first.normal;
-            if let Some(lit) =
-                reference_lit(&reference, first.object, point.to_f64(), facing, light)
+            if let Some((lit, l_dot_n)) =
+                reference_lit(&reference, first.object, point.to_f64(), facing, light, u)
             {
                 shadow_judged += 1;
                 if lit != first.lit {
                     wrong += 1;
+                    m.worst_facing = m.worst_facing.max(l_dot_n.abs());
                 }
             }
         }
     }
     m.stuck = stuck as f64 / first_hits.max(1) as f64;
     m.wrong_shadow = wrong as f64 / shadow_judged.max(1) as f64;
+    m.wrong_shadows = wrong;
     m
 }
 
@@ -238,10 +381,10 @@ struct Truth {
     hit: Option<usize>,
 }
 
-fn reference_hit(objects: &[Object], ray: &Ray) -> Option<Truth> {
+fn reference_hit(objects: &[Object], ray: &Ray, u: f64) -> Option<Truth> {
     let mut nearest: Option<(f64, usize)> = None;
     for (i, o) in objects.iter().enumerate() {
-        if let Some(t) = reference_distance(o, ray)? {
+        if let Some(t) = reference_distance(o, ray, u, 0.0)? {
             if nearest.is_none_or(|(n, _)| t < n) {
                 nearest = Some((t, i));
             }
@@ -253,15 +396,27 @@ fn reference_hit(objects: &[Object], ray: &Ray) -> Option<Truth> {
 }
 
 /// The reference's distance along `ray` to `object`: `Some(None)` for a miss,
-/// `None` when the ray is too close to a sphere's silhouette to judge.
-fn reference_distance(object: &Object, ray: &Ray) -> Option<Option<f64>> {
+/// `None` when the ray is too close to a sphere's silhouette to judge (the band
+/// of [`silhouette_band`] for unit roundoff `u`, widened by `slack`, how far the
+/// ray's origin may be from where the method under test put it), or so nearly
+/// parallel to a plane that the sign of `⟨d, n⟩` is within rounding.
+fn reference_distance(object: &Object, ray: &Ray, u: f64, slack: f64) -> Option<Option<f64>> {
     match object.shape {
-        Shape::Sphere(s) => match exact_sphere(&s, ray) {
-            Crossing::Ambiguous => None,
-            Crossing::Miss => Some(None),
-            Crossing::Hit(t) => Some(Some(t)),
-        },
-        Shape::Plane(_) => Some(object.intersect(ray, Method::Stable)),
+        Shape::Sphere(s) => {
+            let band = silhouette_band(u, ray.origin, &s) + slack;
+            match exact_sphere(&s, ray, band) {
+                Crossing::Ambiguous => None,
+                Crossing::Miss => Some(None),
+                Crossing::Hit(t) => Some(Some(t)),
+            }
+        }
+        Shape::Plane(pl) => {
+            let facing = ray.direction.dot(pl.normal);
+            if facing.abs() <= 4.0 * u * ray.direction.length() * pl.normal.length() {
+                return None;
+            }
+            Some(object.intersect(ray, Method::Stable))
+        }
     }
 }
 
@@ -278,7 +433,7 @@ pub fn outside_exactly(p: Vec3, c: Vec3, r: f64) -> bool {
 
 /// What the exact answer says of a ray and a sphere.
 enum Crossing {
-    /// Within [`SILHOUETTE_BAND`] of the silhouette: not judged.
+    /// Within the silhouette band: not judged.
     Ambiguous,
     /// Not hit by the tutorial's rule (no two crossings, or not both in front).
     Miss,
@@ -289,8 +444,10 @@ enum Crossing {
 /// The tutorial's hit rule decided by signs computed in double-double arithmetic
 /// (about 106 bits), with the ray's direction as it is (not assumed of length 1):
 /// with f = O − C and a = ‖d‖², two crossings iff Δ/4 = ⟨f, d⟩² − a·(‖f‖² − r²) > 0,
-/// both in front iff ‖f‖ > r and ⟨f, d⟩ < 0.
-fn exact_sphere(s: &Sphere, ray: &Ray) -> Crossing {
+/// both in front iff ‖f‖ > r and ⟨f, d⟩ < 0. A ray whose closest approach is
+/// within `band` of the radius (so `|Δ/4| ≈ 2r·|r − D|·a` within `2r·band·a`)
+/// is not judged.
+fn exact_sphere(s: &Sphere, ray: &Ray, band: f64) -> Crossing {
     use dd::Dd;
     let f: [Dd; 3] = [0, 1, 2].map(|i| Dd::diff(ray.origin[i], s.center[i]));
     let d = ray.direction.to_array();
@@ -299,7 +456,7 @@ fn exact_sphere(s: &Sphere, ray: &Ray) -> Crossing {
     let a = (0..3).fold(Dd::ZERO, |acc, i| acc.add(Dd::product(d[i], d[i])));
     let c = ff.sub(Dd::product(s.radius, s.radius));
     let quarter_delta = fd.mul(fd).sub(a.mul(c));
-    if quarter_delta.value().abs() <= 2.0 * SILHOUETTE_BAND * s.radius * s.radius * a.value() {
+    if quarter_delta.value().abs() <= 2.0 * band * s.radius * a.value() {
         return Crossing::Ambiguous;
     }
     if quarter_delta.value() <= 0.0 || c.value() <= 0.0 || fd.value() >= 0.0 {
@@ -371,16 +528,18 @@ pub fn surface_distance(object: &Object, p: Vec3) -> f64 {
 }
 
 /// The reference's shadow verdict at (near) `p` on object `index`, whose face
-/// `facing` was seen, or `None` where
-/// it is too close to call: on the terminator, or with the shadow ray grazing
-/// another sphere.
+/// `facing` was seen, with `L·N` there, or `None` where it is too close to call:
+/// on the terminator ([`terminator_band`]), or with the shadow ray grazing
+/// another sphere (its silhouette band, widened by the `auto` step at `p`: the
+/// shadow ray starts that far from the point judged).
 fn reference_lit(
     objects: &[Object],
     index: usize,
     p: Vec3,
     facing: Vec3,
     light: Vec3,
-) -> Option<bool> {
+    u: f64,
+) -> Option<(bool, f64)> {
     let object = &objects[index];
     let on_surface = object.project(p);
     let normal = match object.shape {
@@ -391,13 +550,18 @@ fn reference_lit(
     };
     let to_light = (light - on_surface).normalize();
     let facing = to_light.dot(normal);
-    if facing.abs() < TERMINATOR_BAND {
+    let (band, size) = match object.shape {
+        Shape::Sphere(s) => (terminator_band(u, s.radius, on_surface), s.radius),
+        Shape::Plane(pl) => (TERMINATOR_BAND, on_surface.distance(pl.point)),
+    };
+    if facing.abs() < band {
         return None;
     }
     // A sphere shadows its own far side; a plane lights both of its faces the same.
     if facing < 0.0 && matches!(object.shape, Shape::Sphere(_)) {
-        return Some(false);
+        return Some((false, facing));
     }
+    let slack = auto_step(u, size, on_surface);
     let ray = Ray {
         origin: on_surface,
         direction: to_light,
@@ -408,17 +572,17 @@ fn reference_lit(
         if i == index {
             continue;
         }
-        if reference_distance(other, &ray)?.is_some_and(|t| t < distance) {
+        if reference_distance(other, &ray, u, slack)?.is_some_and(|t| t < distance) {
             lit = false;
         }
     }
-    Some(lit)
+    Some((lit, facing))
 }
 
 /// The header line of `raystep accuracy`'s table.
 pub fn table_header() -> String {
     format!(
-        "{:<12} {:<4} {:<6} {:<10} {:>7} {:>7} {:>10} {:>9} {:>7} {:>7}",
+        "{:<17} {:<4} {:<6} {:<10} {:>7} {:>7} {:>10} {:>9} {:>7} {:>7} {:>8} {}",
         "case",
         "prec",
         "method",
@@ -428,14 +592,16 @@ pub fn table_header() -> String {
         "surf.err",
         "in u·size",
         "stuck%",
-        "shadow%"
+        "shadow%",
+        "max|L·N|",
+        "limit"
     )
 }
 
 /// One line of `raystep accuracy`'s table.
 pub fn table_row(m: &Measure) -> String {
     format!(
-        "{:<12} {:<4} {:<6} {:<10} {:>7} {:>7} {:>10.1e} {:>9.1} {:>7.2} {:>7.2}",
+        "{:<17} {:<4} {:<6} {:<10} {:>7} {:>7} {:>10.1e} {:>9.1} {:>7.2} {:>7.2} {:>8.1e} {}",
         m.case,
         m.precision,
         m.method,
@@ -445,6 +611,8 @@ pub fn table_row(m: &Measure) -> String {
         m.max_surface_error,
         m.max_surface_error_ulps,
         100.0 * m.stuck,
-        100.0 * m.wrong_shadow
+        100.0 * m.wrong_shadow,
+        m.worst_facing,
+        m.limit
     )
 }

@@ -142,7 +142,7 @@ Limits (a value beyond them is refused with a message, exit code 2):
   max_depth      1 to 64 segments per path (--max-depth, render.max_depth)
   --spp          a square number from 1 to 1024
   numbers        finite, at most 1e15 in magnitude; a radius at least 1e-12 and
-                 1e-6 of the scene's size
+                 1.9e-15 of the scene's size (1e-6 with --precision f32)
   scene files    at most 16 MiB
   generate       at most 100,000 spheres
   chart --scale  a --max-count whose largest scene fits in 2.1 GB: about 750
@@ -327,9 +327,10 @@ pub struct RuleArgs {
     #[arg(long, value_enum)]
     pub intersect: Option<Method>,
     /// How far shadow and reflected rays start from a hit point, along the normal:
-    /// auto (a bound of the rounding error, right at every scale) or fixed:VALUE
-    /// (the tutorial's is fixed:1e-5; fixed:0 shows shadow acne) [default: auto].
-    #[arg(long, value_name = "auto|fixed:VALUE")]
+    /// auto (a bound of the rounding error, right at every scale), scene (raystep's
+    /// first automatic step, 8 u of the surface's size) or fixed:VALUE (the
+    /// tutorial's is fixed:1e-5; fixed:0 shows shadow acne) [default: auto].
+    #[arg(long, value_name = "auto|scene|fixed:VALUE")]
     pub offset: Option<Offset>,
     /// Who views the highlight on a reflection bounce: the camera (the tutorial's
     /// rule) or the ray's origin (the surface the light travels to).
@@ -593,9 +594,15 @@ impl RuleArgs {
         if let Some(spp) = self.spp {
             crate::io::scene_file::check_spp(spp).map_err(Error::Usage)?;
         }
+        let precision = self.precision.unwrap_or(base.precision);
+        let warnings = crate::io::scene_file::check_precision(scene, precision)
+            .map_err(|e| Error::Usage(format!("--precision {precision}: {e}")))?;
+        for warning in warnings {
+            eprintln!("warning: --precision {precision}: {warning}");
+        }
         Ok(Settings {
             stages,
-            precision: self.precision.unwrap_or(base.precision),
+            precision,
             method: self.intersect.unwrap_or(base.method),
             offset: self.offset.unwrap_or(base.offset),
             viewer: self.viewer,

@@ -83,6 +83,10 @@ pub const DIAGRAMS: &[Diagram] = &[
         name: "ch09/cancellation",
         draw: cancellation,
     },
+    Diagram {
+        name: "ch09/bound",
+        draw: bound,
+    },
 ];
 
 /// The scene file at `path` under `root`.
@@ -1367,6 +1371,141 @@ fn cancellation(root: &Path) -> Result<String, Error> {
         font(14.0, INK, Anchor::Start),
     );
     Ok(svg.finish())
+}
+
+// ---------------------------------------------------------------------------
+// Chapter 9: the bound, and what a step of that size costs at the terminator.
+
+/// The scene whose sphere chapter 9's bound diagram draws, in float32.
+pub const TINY_FAR: &str = "scenes/stress/tiny-far.toml";
+
+/// What chapter 9's bound diagram shows, as the crate computes it in float32.
+#[derive(Clone, Copy, Debug)]
+pub struct BoundPicture {
+    /// The sphere, as float32 stores it (exactly, in float64).
+    pub sphere: Sphere,
+    /// The unit normal drawn (where the terminator is, for a light to the side).
+    pub normal: Vec3,
+    /// The steps of `--offset scene` and `--offset auto`, as `step_off` takes
+    /// them in float32, in scene units.
+    pub steps: [f64; 2],
+    /// For each step `h`, the largest |L·N| at which a shadow ray from the
+    /// stepped-off point passes over the sphere: `√(1 − (r/(r + h))²)`.
+    pub reach: [f64; 2],
+}
+
+/// Chapter 9's bound diagram's numbers: the sphere of [`TINY_FAR`] in float32,
+/// stepped off by the book's `step_off` at a point of its side.
+pub fn bound_picture(scene: &Scene) -> Option<BoundPicture> {
+    let (object, _) = first_sphere(scene, Role::Sphere)?;
+    let object32: Object<f32> = object.cast();
+    let Shape::Sphere(s32) = object32.shape else {
+        return None;
+    };
+    let normal = Vec3::new(0.6, 0.8, 0.0);
+    let n32 = glam::Vec3::new(0.6, 0.8, 0.0);
+    let point = s32.center + n32 * s32.radius;
+    let sphere = Sphere {
+        center: s32.center.to_f64(),
+        radius: f64::from(s32.radius),
+    };
+    let steps = [Offset::Scene, Offset::Auto].map(|offset| {
+        let shifted = step_off(point, n32, &object32, offset).to_f64();
+        shifted.distance(sphere.center) - sphere.radius
+    });
+    let reach = steps.map(|h| (1.0 - (sphere.radius / (sphere.radius + h)).powi(2)).sqrt());
+    Some(BoundPicture {
+        sphere,
+        normal,
+        steps,
+        reach,
+    })
+}
+
+fn bound(root: &Path) -> Result<String, Error> {
+    let scene = scene_at(root, TINY_FAR)?;
+    let p = bound_picture(&scene).ok_or_else(|| missing(TINY_FAR, "a sphere"))?;
+    let r = p.sphere.radius;
+    let mut svg = Svg::new(
+        720,
+        380,
+        &format!(
+            "Two panels at true scale: a sphere of radius {} about 1,000 from the origin, in \
+             float32. Left, the scene-sized step {} puts the shadow ray's origin {:.2} of a \
+             radius out, and a shadow ray passes over the sphere up to |L·N| = {:.2}. Right, \
+             the bound's step {} puts it {:.2} of a radius out: up to |L·N| = {:.2}",
+            dec(r, 3),
+            sci(p.steps[0]),
+            p.steps[0] / r,
+            p.reach[0],
+            sci(p.steps[1]),
+            p.steps[1] / r,
+            p.reach[1]
+        ),
+    );
+    let title = Font {
+        bold: true,
+        ..font(16.0, INK, Anchor::Start)
+    };
+    let note = font(13.0, GREY, Anchor::Start);
+    let scale = 110.0 / r;
+    let labels = [
+        ("--offset scene", "8·u·(|C| + r): the size of the scene"),
+        ("--offset auto", "u·(10·r + 3·‖S‖): a bound of the error"),
+    ];
+    for (panel, left) in [(0usize, 0.0), (1, 360.0)] {
+        let centre = px(left + 150.0, 240.0);
+        let at = |v: Vec3| centre + px(scale * v.x, -scale * v.y);
+        svg.circle(centre, scale * r, SPHERE_FILL, Some(pen(SPHERE_EDGE, 2.0)));
+        let h = p.steps[panel];
+        let on = p.normal * r;
+        let out = p.normal * (r + h);
+        svg.dot(at(on), INK, 4.0);
+        svg.text(at(on) + px(-8.0, 16.0), "*S*", font(15.0, INK, Anchor::End));
+        svg.line(at(on), at(out), pen(ORANGE, 2.0));
+        svg.dot(at(out), ORANGE, 4.5);
+        svg.text(
+            at(out) + px(8.0, -6.0),
+            "*O*′",
+            font(15.0, INK, Anchor::Start),
+        );
+        // The shadow ray from O′ that just touches the sphere: every ray from O′
+        // below it (towards the sphere's dark side, at a smaller |L·N|) passes over.
+        let d = r + h;
+        let tangent_angle = (r / d).acos();
+        let base = p.normal.y.atan2(p.normal.x);
+        let touch_angle = base - tangent_angle;
+        let touch = Vec3::new(touch_angle.cos(), touch_angle.sin(), 0.0) * r;
+        let towards = touch - out;
+        let far = out + towards * (1.0 + 1.4 * r / towards.length());
+        svg.arrow(at(out), at(far), pen(ORANGE, 1.8));
+        svg.text(px(left + 20.0, 28.0), labels[panel].0, title);
+        svg.text(px(left + 20.0, 50.0), labels[panel].1, note);
+        svg.text(
+            px(left + 20.0, 70.0),
+            &format!("step {} = {:.2}·r", sci(h), h / r),
+            note,
+        );
+        svg.text(
+            px(left + 20.0, 90.0),
+            &format!("passes over up to |L·N| = {:.2}", p.reach[panel]),
+            font(13.0, ORANGE, Anchor::Start),
+        );
+    }
+    svg.text(
+        px(20.0, 370.0),
+        &format!(
+            "Radius {}, centre about 1,000 from the origin, float32: true scale.",
+            dec(r, 3)
+        ),
+        font(13.0, GREY, Anchor::Start),
+    );
+    Ok(svg.finish())
+}
+
+/// A short number in scientific notation, e.g. `3.8e-4`.
+fn sci(v: f64) -> String {
+    format!("{v:.1e}")
 }
 
 /// The distance from `x` to the next float32 number away from zero.

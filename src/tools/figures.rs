@@ -64,6 +64,8 @@ pub const FIGURES: &[Figure] = &[
     fig("ch09/x0001-auto", "render scenes/stress/seed-x0.001.toml", &[Shadow]),
     fig("ch09/plane-no-step", "render scenes/stress/horizon-true.toml --offset fixed:0", &[Beauty, Shadow]),
     fig("ch09/plane-auto", "render scenes/stress/horizon-true.toml", &[Beauty, Shadow]),
+    fig("ch09/tiny-far-scene", "render scenes/stress/tiny-far.toml --precision f32 --offset scene", &[Beauty, Shadow]),
+    fig("ch09/tiny-far-auto", "render scenes/stress/tiny-far.toml --precision f32", &[Beauty, Shadow]),
     fig("ch11/seed", "render scenes/seed.toml", &[Beauty, Object, Shadow, Ambient, Diffuse, Specular, Bounces, Rays]),
 ];
 
