@@ -1095,15 +1095,32 @@ fn exr_block(frame: &Frame, order: &[usize], index: BlockIndex) -> Vec<u8> {
         terms.clear();
         rays.extend((x0..x0 + width).map(|col| frame.ray_buffers(row, col as u32)));
         terms.extend(pixels.iter().map(|p| frame.terms(p)));
-        // Channel after channel, each a loop along the line.
+        // Channel after channel, each a loop along the line of its own (the
+        // channel's rule chosen once per line, not per sample).
         for (&k, bytes) in order.iter().zip(&mut channel_rows) {
-            let samples = pixels.iter().zip(&rays).zip(&terms);
-            for (b, ((p, ray), terms)) in bytes.chunks_exact_mut(4).zip(samples) {
-                b.copy_from_slice(&exr_sample(k, p, ray, terms).to_ne_bytes());
+            // The same numbers as `exr_sample` (tests/exr_readers.rs compares
+            // every sample); the rest through it.
+            match k {
+                0..=2 => fill_samples(bytes, |x| pixels[x].colour[k]),
+                3..=5 => fill_samples(bytes, |x| rays[x].0[k - 3]),
+                6 => fill_samples(bytes, |x| pixels[x].depth),
+                7..=9 => fill_samples(bytes, |x| pixels[x].normal[k - 7]),
+                10..=12 => fill_samples(bytes, |x| rays[x].1[k - 10]),
+                15..=23 => fill_samples(bytes, |x| terms[x][(k - 15) / 3][(k - 15) % 3]),
+                _ => fill_samples(bytes, |x| exr_sample(k, &pixels[x], &rays[x], &terms[x])),
             }
         }
     }
     data
+}
+
+/// Fill one channel's samples of a line, `sample(x)` at column `x`, as native
+/// float32 bytes.
+#[inline(always)]
+fn fill_samples(bytes: &mut [u8], sample: impl Fn(usize) -> f32) {
+    for (x, b) in bytes.chunks_exact_mut(4).enumerate() {
+        b.copy_from_slice(&sample(x).to_ne_bytes());
+    }
 }
 // ANCHOR_END: exr
 
