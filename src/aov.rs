@@ -10,6 +10,7 @@
 //! | `direction` | `rays` (always on) | the primary ray's unit direction, world space |
 //! | `depth` | `intersection` on | distance along the primary ray to the first hit (the ray's `t`; the direction is a unit vector, so this is the distance from the camera); `+∞` on a miss |
 //! | `normal` | `intersection` on | unit world-space normal at the first hit (outward for a sphere, towards the camera for a plane); `(0, 0, 0)` on a miss |
+//! | `position` | `intersection` on | `P`, the first hit's point in world space: the primary ray's origin + `depth`·direction, computed again from the camera as `direction` is, in the frame's precision, with the `depth` the record keeps (float32); `(0, 0, 0)` on a miss, as `normal` and as renderers' position passes (Cycles', Arnold's) give it: compositing filters spread a NaN over its neighbours, and `Z` = `+∞` or `object` = `−1` already tell a miss from a hit at the origin |
 //! | `shadow` | `intersection` on | `1` lit, `0` in shadow, `−1` on a miss. Before the `shadow` stage is on no shadow ray is cast, so every hit reads `1` |
 //! | `object` | `intersection` on | index of the object hit first, among the objects in play (spheres in file order, then the `[[plane]]` entries); `−1` on a miss |
 //! | `ambient`, `diffuse`, `specular` | `blinn-phong` on | the three Blinn-Phong terms of the first hit (`ka·la`, `kd·ld·(L·N)`, `ks·ls·(N·H)^(shininess/4)`), as added to the pixel; `0` in shadow and on a miss, where none is computed |
@@ -32,6 +33,8 @@ pub enum Buffer {
     Depth,
     /// Normal at the first hit.
     Normal,
+    /// World position of the first hit (`P`).
+    Position,
     /// Lit, shadowed or missed.
     Shadow,
     /// Which object the primary ray hit first.
@@ -50,11 +53,12 @@ pub enum Buffer {
 
 impl Buffer {
     /// Every buffer, in the order files are written.
-    pub const ALL: [Buffer; 11] = [
+    pub const ALL: [Buffer; 12] = [
         Buffer::Beauty,
         Buffer::Direction,
         Buffer::Depth,
         Buffer::Normal,
+        Buffer::Position,
         Buffer::Shadow,
         Buffer::Object,
         Buffer::Ambient,
@@ -71,6 +75,7 @@ impl Buffer {
             Buffer::Direction => "direction",
             Buffer::Depth => "depth",
             Buffer::Normal => "normal",
+            Buffer::Position => "position",
             Buffer::Shadow => "shadow",
             Buffer::Object => "object",
             Buffer::Ambient => "ambient",
@@ -87,9 +92,12 @@ impl Buffer {
     pub fn written(self, stages: Stages) -> bool {
         match self {
             Buffer::Beauty | Buffer::Direction => true,
-            Buffer::Depth | Buffer::Normal | Buffer::Shadow | Buffer::Object | Buffer::Rays => {
-                stages.intersection
-            }
+            Buffer::Depth
+            | Buffer::Normal
+            | Buffer::Position
+            | Buffer::Shadow
+            | Buffer::Object
+            | Buffer::Rays => stages.intersection,
             Buffer::Ambient | Buffer::Diffuse | Buffer::Specular => {
                 stages.intersection && stages.blinn_phong
             }
@@ -332,6 +340,43 @@ impl Frame {
             Precision::F64 => self.camera.primary_ray::<f64>(row, col).direction,
         };
         d.as_vec3().to_array()
+    }
+
+    /// The world position `P` of pixel (`row`, `col`)'s first hit: its primary ray
+    /// computed again as [`Frame::direction`] does, walked the record's `depth`
+    /// along (`origin + depth·direction`, in the frame's precision); `(0, 0, 0)`
+    /// on a miss.
+    pub fn position(&self, row: u32, col: u32) -> [f32; 3] {
+        self.ray_buffers(row, col).1
+    }
+
+    /// [`Frame::direction`] and [`Frame::position`] of one pixel, its primary ray
+    /// computed once for both.
+    #[inline]
+    pub fn ray_buffers(&self, row: u32, col: u32) -> ([f32; 3], [f32; 3]) {
+        let record = self.at(row, col);
+        match self.precision {
+            Precision::F32 => self.ray_buffers_in::<f32>(row, col, record),
+            Precision::F64 => self.ray_buffers_in::<f64>(row, col, record),
+        }
+    }
+
+    #[inline]
+    fn ray_buffers_in<T: crate::real::Real>(
+        &self,
+        row: u32,
+        col: u32,
+        record: &PixelRecord,
+    ) -> ([f32; 3], [f32; 3]) {
+        let ray = self.camera.primary_ray::<T>(row, col);
+        let direction = ray.direction.to_f64().as_vec3().to_array();
+        let position = if record.is_hit() {
+            let t = T::of(f64::from(record.depth));
+            ray.at(t).to_f64().as_vec3().to_array()
+        } else {
+            [0.0; 3]
+        };
+        (direction, position)
     }
 
     /// The buffers this frame holds, in file order.

@@ -119,6 +119,7 @@ fn render_writes_one_configuration_at_the_size_asked_and_no_temporary_files() {
             "direction.png",
             "normal.png",
             "object.png",
+            "position.png",
             "rays.png",
             "shadow.png",
             "specular.png"
@@ -461,13 +462,13 @@ fn json_outputs_carry_schema_1_and_the_documented_fields() {
         ],
     );
     let files = render["files"].as_array().unwrap();
-    assert_eq!(files.len(), 12, "eleven pictures and the EXR: {render}");
+    assert_eq!(files.len(), 13, "twelve pictures and the EXR: {render}");
     for file in files {
         let path = dir.path().join(file["path"].as_str().unwrap());
         let bytes = std::fs::metadata(&path).unwrap().len();
         assert_eq!(file["bytes"].as_u64(), Some(bytes), "{}", path.display());
     }
-    assert_eq!(render["buffers"].as_array().unwrap().len(), 11);
+    assert_eq!(render["buffers"].as_array().unwrap().len(), 12);
     for key in ["render", "write", "total"] {
         assert!(render["seconds"][key].as_f64().unwrap() >= 0.0, "{render}");
     }

@@ -19,6 +19,13 @@ fn agrees_everywhere(scene: &Scene, settings: &Settings) {
             let story = explain(scene, settings, x, y);
             let record = frame.at(y, x);
             check(&story, record, settings);
+            // The position buffer, which the record does not hold.
+            let position = story.position.map(|p| p.map(|c| c as f32));
+            let expected = record.is_hit().then(|| frame.position(y, x));
+            let at = format!("pixel {x},{y} under {settings:?}");
+            if settings.stages.intersection {
+                assert_eq!(position, expected, "{at}");
+            }
         }
     }
 }
@@ -178,10 +185,20 @@ fn json_has_the_depth_or_null_and_the_cli_checks_the_pixel() {
     };
     let sky = json("0,0");
     assert!(sky["depth"].is_null(), "{sky}");
+    assert!(sky["position"].is_null(), "{sky}");
     let sphere = json("150,60");
     let depth = sphere["depth"].as_f64().unwrap();
     assert_eq!(sphere["segments"][0]["hit"]["t"].as_f64(), Some(depth));
     assert!((1.0..2.0).contains(&depth), "{depth}");
+    // P is the hit's point, within float32's rounding.
+    let point = &sphere["segments"][0]["hit"]["point"];
+    for k in 0..3 {
+        let (p, q) = (
+            sphere["position"][k].as_f64().unwrap(),
+            point[k].as_f64().unwrap(),
+        );
+        assert!((p - q).abs() <= 1e-6 * (1.0 + q.abs()), "{p} {q}");
+    }
 
     for (pixel, message) in [
         ("300,10", "outside the 300 × 200 image"),

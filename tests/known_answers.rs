@@ -108,10 +108,15 @@ fn the_exr_holds_the_exact_depth_of_a_pixel() {
     assert_eq!(at("Z", 2, 2), 3.0);
     assert_eq!(at("Z", 0, 0), f32::INFINITY);
     assert_eq!(at("N.Z", 2, 2), 1.0);
-    assert_eq!(at("shadow", 2, 2), 1.0);
-    assert_eq!(at("shadow", 0, 0), -1.0);
+    assert_eq!(at("shadow.X", 2, 2), 1.0);
+    assert_eq!(at("shadow.X", 0, 0), -1.0);
     assert!((at("R", 2, 2) - 0.85).abs() < 1e-6);
     assert_eq!(at("dir.Z", 2, 2), -1.0);
+    // P: from the camera at z = 1, 3 along −z, the sphere's front at z = −2; a
+    // miss holds (0, 0, 0).
+    let p = |row, col| ["P.X", "P.Y", "P.Z"].map(|c| at(c, row, col));
+    assert_eq!(p(2, 2), [0.0, 0.0, -2.0]);
+    assert_eq!(p(0, 0), [0.0; 3]);
 }
 
 #[test]

@@ -19,7 +19,7 @@ use serde_json::Value;
 const VIEWPORT: (u32, u32) = (1400, 1000);
 
 /// The fields of `pixels.js`, as the page shows them, and their EXR channels.
-const FIELDS: [(&str, &str); 11] = [
+const FIELDS: [(&str, &str); 14] = [
     ("R", "R"),
     ("G", "G"),
     ("B", "B"),
@@ -27,10 +27,13 @@ const FIELDS: [(&str, &str); 11] = [
     ("N.X", "N.X"),
     ("N.Y", "N.Y"),
     ("N.Z", "N.Z"),
-    ("shadow", "shadow"),
-    ("object", "object"),
-    ("bounces", "bounces"),
-    ("rays", "rays"),
+    ("P.X", "P.X"),
+    ("P.Y", "P.Y"),
+    ("P.Z", "P.Z"),
+    ("shadow", "shadow.X"),
+    ("object", "object.X"),
+    ("bounces", "bounces.X"),
+    ("rays", "rays.X"),
 ];
 
 fn manifest_dir() -> PathBuf {
@@ -114,13 +117,13 @@ fn the_page_shows_the_exact_numbers_of_the_pixel_under_the_mouse() {
     let plane = exr("06-plane");
     let sky = plane.middle_pixel(|x, y| plane.at("Z", x, y) == Some(f32::INFINITY));
     let red = plane.middle_pixel(|x, y| {
-        plane.at("object", x, y) == Some(0.0) && plane.at("shadow", x, y) == Some(1.0)
+        plane.at("object.X", x, y) == Some(0.0) && plane.at("shadow.X", x, y) == Some(1.0)
     });
     let floor_in_shadow = plane.middle_pixel(|x, y| {
-        plane.at("shadow", x, y) == Some(0.0) && plane.at("N.Y", x, y).unwrap() > 0.99
+        plane.at("shadow.X", x, y) == Some(0.0) && plane.at("N.Y", x, y).unwrap() > 0.99
     });
     let shadow = exr("03-shadow");
-    let shadowed = shadow.middle_pixel(|x, y| shadow.at("shadow", x, y) == Some(0.0));
+    let shadowed = shadow.middle_pixel(|x, y| shadow.at("shadow.X", x, y) == Some(0.0));
     let probes = [
         ("01-rays", "direction", (150, 100)),
         ("03-shadow", "normal", shadowed),

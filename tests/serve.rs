@@ -285,7 +285,7 @@ fn render_answers_the_png_the_command_line_writes() {
     assert_eq!(reply.header("X-Raystep-Size"), Some("300x200"));
     assert_eq!(
         reply.header("X-Raystep-Buffers"),
-        Some("beauty,direction,depth,normal,shadow,object,ambient,diffuse,specular,bounces,rays")
+        Some("beauty,direction,depth,normal,position,shadow,object,ambient,diffuse,specular,bounces,rays")
     );
 }
 

@@ -11,6 +11,7 @@ const BUFFER_OF = {
   R: "beauty", G: "beauty", B: "beauty",
   depth: "depth",
   "N.X": "normal", "N.Y": "normal", "N.Z": "normal",
+  "P.X": "position", "P.Y": "position", "P.Z": "position",
   shadow: "shadow",
   object: "object",
   bounces: "bounces",

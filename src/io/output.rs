@@ -9,9 +9,13 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
+use exr::block::writer::ChunksWriter;
+use exr::block::BlockIndex;
+use exr::meta::header::Header;
+use exr::meta::BlockDescription;
 use exr::prelude::{
-    Blocks, ChannelDescription, Compression, Encoding, Image, Layer, LayerAttributes, LineOrder,
-    SampleType, SpecificChannels, Vec2, WritableImage,
+    ChannelDescription, Compression, ImageAttributes, IntegerBounds, LayerAttributes, LineOrder,
+    SampleType, SmallVec, Text, Vec2,
 };
 
 use crate::aov::{Buffer, Frame, PixelRecord, NO_OBJECT};
@@ -115,6 +119,8 @@ pub struct Pending {
     folders: Vec<(PathBuf, Option<fs::File>, Option<Identity>)>,
     /// How [`Pending::frame`] encodes the colour pictures.
     png: PngEncoding,
+    /// How [`Pending::frame`] compresses the EXR file.
+    exr: ExrCompression,
 }
 
 /// Which file or folder stands at a path: its device and inode.
@@ -136,6 +142,13 @@ impl Pending {
     /// says (`--png`; linear without it).
     pub fn with_png(mut self, png: PngEncoding) -> Pending {
         self.png = png;
+        self
+    }
+
+    /// The same, with the EXR file of [`Pending::frame`] compressed as `exr`
+    /// says (`--exr-compression`; uncompressed without it).
+    pub fn with_exr(mut self, exr: ExrCompression) -> Pending {
+        self.exr = exr;
         self
     }
 
@@ -191,9 +204,10 @@ impl Pending {
     /// render that this frame does not have (say `depth.png` after a `rays`-only
     /// render) will be removed by the commit. Returns the files' final paths.
     ///
-    /// The EXR file is streamed from the frame to its file, scan line by scan
-    /// line, so no copy of the buffers is made: at 1920 × 1080 the frame's 100 MB
-    /// is most of what the whole render holds in memory.
+    /// The EXR file is streamed from the frame to its file, a few dozen blocks
+    /// of scan lines at a time, and the pictures drawn a few at a time, so no copy
+    /// of the buffers is made: at 1920 × 1080 the frame's 108 MB is most of what
+    /// the whole render holds in memory.
     pub fn frame(&mut self, frame: &Frame, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         let buffers: Vec<Buffer> = frame.buffers().collect();
         let mut paths: Vec<PathBuf> = buffers
@@ -206,21 +220,17 @@ impl Pending {
             path: path.to_path_buf(),
             message,
         };
-        // Encode and write every file in parallel (each encoder is deterministic).
-        let png = self.png;
+        // The EXR beside the pictures, each deterministic: the EXR's blocks and
+        // the pictures share rayon's threads.
+        let (png, compression) = (self.png, self.exr);
+        let n = buffers.len();
         let (pngs, exr) = rayon::join(
             || {
-                buffers
-                    .par_iter()
-                    .zip(&paths)
-                    .zip(&temporaries)
-                    .map(|((&b, path), temporary)| {
-                        write_new(temporary, &png_bytes_as(frame, b, png))
-                            .map_err(|e| fail(path, e.to_string()))
-                    })
-                    .collect::<Result<Vec<()>, Error>>()
+                png_files(frame, &buffers, png, |k, bytes| {
+                    write_new(&temporaries[k], bytes).map_err(|e| fail(&paths[k], e.to_string()))
+                })
             },
-            || write_exr(frame, &temporaries[buffers.len()], &paths[buffers.len()]),
+            || write_exr(frame, compression, &temporaries[n], &paths[n]),
         );
         pngs.and(exr)?;
         self.stale.extend(
@@ -480,6 +490,11 @@ fn remove_abandoned_temporaries(dir: &Path) {
 /// - `depth`: grey, `nearest depth / depth`, so the nearest hit is white and
 ///   distance darkens it (1/depth keeps near detail visible when the floor runs
 ///   far away);
+/// - `position`: each coordinate's fractional part, `P − ⌊P⌋`, as red, green and
+///   blue: a ramp that starts again at every whole world unit, so the edges of the
+///   colour bands are the lines x, y or z = integer (no picture can hold the
+///   floor's far points and the spheres' near ones in one scale; the numbers are in
+///   `buffers.exr` and the page);
 /// - `shadow`: white lit, black in shadow;
 /// - `object`: a colour of its own for each object (hues a golden angle apart);
 /// - `ambient`, `diffuse`, `specular`: the term's colour, clipped to [0, 1];
@@ -496,64 +511,228 @@ pub fn visualise(frame: &Frame, buffer: Buffer) -> Vec<u8> {
 /// The 8-bit picture of one buffer, as [`visualise`] draws it, its colour
 /// pictures encoded as `png` says (see [`PngEncoding`]).
 pub fn visualise_as(frame: &Frame, buffer: Buffer, png: PngEncoding) -> Vec<u8> {
-    let tone = |colour: [f32; 3]| match png {
-        PngEncoding::Linear => colour,
-        PngEncoding::Srgb => colour.map(srgb_encode),
-    };
-    // Each statistic is a pass over the whole frame (100 MB at 1920 × 1080), so
-    // only the buffer that shows it computes it.
-    let largest = |count: fn(&PixelRecord) -> u32| frame.pixels.par_iter().map(count).max();
-    let (nearest, most) = match buffer {
-        Buffer::Depth => {
-            let depths = frame.pixels.par_iter().map(|p| p.depth);
-            (depths.reduce(|| f32::INFINITY, f32::min), 0)
-        }
-        Buffer::Bounces => (0.0, largest(|p| p.bounces).unwrap_or(0)),
-        Buffer::Rays => (0.0, largest(|p| p.rays).unwrap_or(0)),
-        _ => (0.0, 0),
-    };
-    // The heat map's colour of every count from 0 to `most`, worked out once: per
-    // pixel, the colour map's own lookup costs about 35 ns (a table, 0.6 ns).
-    let heats: Vec<[f32; 3]> = match most {
-        0..=65_536 => (0..=most).map(|k| heat(k, most)).collect(),
-        _ => Vec::new(),
-    };
-    let hot = |count: u32| {
-        heats
-            .get(count as usize)
-            .copied()
-            .unwrap_or_else(|| heat(count, most))
-    };
-    picture(frame, |row, col, p| match buffer {
-        Buffer::Beauty => tone(p.colour),
-        Buffer::Direction => unit_vector_colour(frame.direction(row, col)),
-        Buffer::Bounces => hot(p.bounces),
-        Buffer::Rays => hot(p.rays),
-        _ if !p.is_hit() => miss_colour(row, col),
-        Buffer::Depth => [nearest / p.depth; 3],
-        Buffer::Normal => unit_vector_colour(p.normal),
-        Buffer::Shadow => [p.shadow; 3],
-        Buffer::Object => object_colour(p.object),
-        Buffer::Ambient => tone(frame.terms(p)[0]),
-        Buffer::Diffuse => tone(frame.terms(p)[1]),
-        Buffer::Specular => tone(frame.terms(p)[2]),
-    })
+    let palette = Palette::new(frame, png, &[buffer]);
+    palette.pictures(&[buffer]).remove(0)
 }
 
-/// The 8-bit RGB bytes of `colour(row, col, record)` for every pixel, row by row
-/// in parallel (each row's bytes depend on that row alone).
-fn picture(frame: &Frame, colour: impl Fn(u32, u32, &PixelRecord) -> [f32; 3] + Sync) -> Vec<u8> {
-    let width = frame.width as usize;
-    let mut rgb = vec![0; frame.pixels.len() * 3];
-    rgb.par_chunks_mut(width * 3)
-        .zip(frame.pixels.par_chunks(width))
-        .enumerate()
-        .for_each(|(row, (bytes, pixels))| {
-            for (col, (out, p)) in bytes.chunks_exact_mut(3).zip(pixels).enumerate() {
-                out.copy_from_slice(&colour(row as u32, col as u32, p).map(to_byte));
+/// What the pictures of a frame need besides each pixel's record: the frame's
+/// nearest depth and largest counts, found in one pass over the records.
+struct Palette<'a> {
+    frame: &'a Frame,
+    png: PngEncoding,
+    /// The nearest depth (`depth`'s white).
+    nearest: f32,
+    /// The heat maps of `bounces` and `rays`.
+    bounces: Heat,
+    rays: Heat,
+    /// The colour of each object in play ([`object_colour`], three `fmod` a
+    /// call).
+    objects: Vec<[f32; 3]>,
+}
+
+/// A heat map from 0 to `most`, its colours worked out once: per pixel, the
+/// colour map's own lookup costs about 35 ns (a table, 0.6 ns).
+struct Heat {
+    most: u32,
+    table: Vec<[f32; 3]>,
+}
+
+impl Heat {
+    fn new(most: u32) -> Heat {
+        let table = match most {
+            0..=65_536 => (0..=most).map(|k| heat(k, most)).collect(),
+            _ => Vec::new(),
+        };
+        Heat { most, table }
+    }
+
+    fn colour(&self, count: u32) -> [f32; 3] {
+        (self.table.get(count as usize).copied()).unwrap_or_else(|| heat(count, self.most))
+    }
+}
+
+/// The pictures of at most this many bytes are drawn together in one pass over
+/// the records, then encoded in parallel: two at 1920 × 1080 (6.2 MB each), all
+/// twelve up to about 680 × 680. Drawing all twelve at 1080p at once would hold
+/// 75 MB of pictures beside the frame's 108 MB of records, where the render's
+/// peak memory is to stay at 150 MB.
+const PICTURES_AT_ONCE: usize = 16 << 20;
+
+impl<'a> Palette<'a> {
+    /// The palette of `frame` for drawing `buffers`: one pass over the records
+    /// for the statistics those buffers need (none for most).
+    fn new(frame: &'a Frame, png: PngEncoding, buffers: &[Buffer]) -> Palette<'a> {
+        let needs = |b: Buffer| buffers.contains(&b);
+        let (depth, bounces, rays) = (
+            needs(Buffer::Depth),
+            needs(Buffer::Bounces),
+            needs(Buffer::Rays),
+        );
+        let (nearest, most_bounces, most_rays) = if depth || bounces || rays {
+            frame
+                .pixels
+                .par_iter()
+                .map(|p| (p.depth, p.bounces, p.rays))
+                .reduce(
+                    || (f32::INFINITY, 0, 0),
+                    |a, b| (a.0.min(b.0), a.1.max(b.1), a.2.max(b.2)),
+                )
+        } else {
+            (f32::INFINITY, 0, 0)
+        };
+        Palette {
+            frame,
+            png,
+            nearest,
+            bounces: Heat::new(if bounces { most_bounces } else { 0 }),
+            rays: Heat::new(if rays { most_rays } else { 0 }),
+            objects: (0..frame.term_colours.len() as u32)
+                .map(object_colour)
+                .collect(),
+        }
+    }
+
+    fn tone(&self, colour: [f32; 3]) -> [f32; 3] {
+        match self.png {
+            PngEncoding::Linear => colour,
+            PngEncoding::Srgb => colour.map(srgb_encode),
+        }
+    }
+
+    /// The 8-bit RGB bytes of each of `buffers`, drawn in one pass over the
+    /// records, row by row in parallel (each row's bytes depend on that row
+    /// alone): a row's records are read from memory once, and each picture's row
+    /// drawn from them in a loop of its own. What several buffers share (the
+    /// primary ray, the Blinn-Phong terms) is computed once per pixel.
+    fn pictures(&self, buffers: &[Buffer]) -> Vec<Vec<u8>> {
+        let frame = self.frame;
+        let width = frame.width as usize;
+        let mut pictures: Vec<Vec<u8>> = buffers
+            .iter()
+            .map(|_| vec![0; frame.pixels.len() * 3])
+            .collect();
+        // Each row of every picture, gathered by row.
+        let mut rows: Vec<Vec<&mut [u8]>> = (0..frame.height)
+            .map(|_| Vec::with_capacity(buffers.len()))
+            .collect();
+        for picture in &mut pictures {
+            for (row, bytes) in picture.chunks_exact_mut(width * 3).enumerate() {
+                rows[row].push(bytes);
             }
-        });
-    rgb
+        }
+        let uses = |wanted: &[Buffer]| buffers.iter().any(|b| wanted.contains(b));
+        let rays = uses(&[Buffer::Direction, Buffer::Position]);
+        let terms = uses(&[Buffer::Ambient, Buffer::Diffuse, Buffer::Specular]);
+        rows.into_par_iter()
+            .zip(frame.pixels.par_chunks(width))
+            .enumerate()
+            .for_each_init(
+                || (Vec::new(), Vec::new(), vec![[0.0; 3]; frame.width as usize]),
+                |(ray_row, terms_row, colours), (row, (outs, pixels))| {
+                    let row = row as u32;
+                    ray_row.clear();
+                    terms_row.clear();
+                    if rays {
+                        ray_row.extend((0..frame.width).map(|col| frame.ray_buffers(row, col)));
+                    }
+                    if terms {
+                        terms_row.extend(pixels.iter().map(|p| frame.terms(p)));
+                    }
+                    for (out, &buffer) in outs.into_iter().zip(buffers) {
+                        self.draw_row(buffer, row, pixels, ray_row, terms_row, colours);
+                        // A loop of its own, which the compiler vectorises.
+                        for (byte, &v) in out.iter_mut().zip(colours.as_flattened()) {
+                            *byte = to_byte(v);
+                        }
+                    }
+                },
+            );
+        pictures
+    }
+
+    /// Draw `buffer`'s row `row` into `out` (a colour a pixel) from the row's
+    /// records, and its primary rays and Blinn-Phong terms where the buffer uses
+    /// them.
+    fn draw_row(
+        &self,
+        buffer: Buffer,
+        row: u32,
+        pixels: &[PixelRecord],
+        rays: &[([f32; 3], [f32; 3])],
+        terms: &[[[f32; 3]; 3]],
+        out: &mut [[f32; 3]],
+    ) {
+        // One loop per buffer, the colour rule known inside it; the buffers of
+        // the first hit draw a miss as the checkerboard.
+        let tone = |c: [f32; 3]| self.tone(c);
+        match buffer {
+            Buffer::Beauty => fill_row(out, pixels, &|_, p| tone(p.colour)),
+            Buffer::Direction => fill_row(out, pixels, &|col, _| unit_vector_colour(rays[col].0)),
+            Buffer::Bounces => fill_row(out, pixels, &|_, p| self.bounces.colour(p.bounces)),
+            Buffer::Rays => fill_row(out, pixels, &|_, p| self.rays.colour(p.rays)),
+            Buffer::Depth => fill_row(
+                out,
+                pixels,
+                &first_hit(row, &|_, p| [self.nearest / p.depth; 3]),
+            ),
+            Buffer::Normal => fill_row(
+                out,
+                pixels,
+                &first_hit(row, &|_, p| unit_vector_colour(p.normal)),
+            ),
+            Buffer::Position => fill_row(
+                out,
+                pixels,
+                &first_hit(row, &|col, _| rays[col].1.map(|v| v - v.floor())),
+            ),
+            Buffer::Shadow => fill_row(out, pixels, &first_hit(row, &|_, p| [p.shadow; 3])),
+            Buffer::Object => fill_row(
+                out,
+                pixels,
+                &first_hit(row, &|_, p| {
+                    (self.objects.get(p.object as usize).copied())
+                        .unwrap_or_else(|| object_colour(p.object))
+                }),
+            ),
+            Buffer::Ambient => {
+                fill_row(out, pixels, &first_hit(row, &|col, _| tone(terms[col][0])))
+            }
+            Buffer::Diffuse => {
+                fill_row(out, pixels, &first_hit(row, &|col, _| tone(terms[col][1])))
+            }
+            Buffer::Specular => {
+                fill_row(out, pixels, &first_hit(row, &|col, _| tone(terms[col][2])))
+            }
+        }
+    }
+}
+
+/// Fill a picture's row with `colour(column, record)`.
+#[inline(always)]
+fn fill_row(
+    out: &mut [[f32; 3]],
+    pixels: &[PixelRecord],
+    colour: &impl Fn(usize, &PixelRecord) -> [f32; 3],
+) {
+    for (col, (c, p)) in out.iter_mut().zip(pixels).enumerate() {
+        *c = colour(col, p);
+    }
+}
+
+/// `colour` where the primary ray hit something, the checkerboard of a miss
+/// elsewhere (on row `row`).
+#[inline(always)]
+fn first_hit<'a>(
+    row: u32,
+    colour: &'a impl Fn(usize, &PixelRecord) -> [f32; 3],
+) -> impl Fn(usize, &PixelRecord) -> [f32; 3] + 'a {
+    move |col, p| {
+        if p.is_hit() {
+            colour(col, p)
+        } else {
+            miss_colour(row, col as u32)
+        }
+    }
 }
 
 /// Object `id`'s colour: its hue turns by the golden angle from one object to
@@ -595,12 +774,24 @@ fn miss_colour(row: u32, col: u32) -> [f32; 3] {
 
 /// A channel from [0, 1] to 8 bits, rounded to the nearest level (clipped first).
 pub(crate) fn to_byte(v: f32) -> u8 {
-    let scaled = v.clamp(0.0, 1.0) * 255.0;
-    // `scaled.round()`, halves away from zero, without the call to the C library's
-    // `roundf` that x86-64 makes for it (perf: 7 % of a whole 1080p render).
-    // `scaled - whole` is exact, and NaN gives 0 as `round` does.
-    let whole = scaled as u8;
-    whole + u8::from(scaled - f32::from(whole) >= 0.5)
+    // Clipped to [0, 1], a NaN to 0 (as `round` would make of it).
+    let scaled = if v > 0.0 { v.min(1.0) } else { 0.0 } * 255.0;
+    // `scaled.round()`, halves away from zero, in float arithmetic only, which the
+    // compiler runs four values at a time in a loop of `to_byte`s (`round` is a
+    // call to the C library's `roundf` on x86-64, and a conversion to an integer
+    // one value at a time). Adding and taking away 2²³ rounds to the nearest
+    // whole number (halves to even), one less if that went up: the whole part.
+    // `scaled - whole` is exact.
+    const TWO_23: f32 = 8_388_608.0;
+    let nearest = (scaled + TWO_23) - TWO_23;
+    let whole = if nearest > scaled {
+        nearest - 1.0
+    } else {
+        nearest
+    };
+    let rounded = whole + if scaled - whole >= 0.5 { 1.0 } else { 0.0 };
+    // A whole number from 0 to 255 plus 2²³ has it in its low mantissa bits.
+    (rounded + TWO_23).to_bits() as u8
 }
 // ANCHOR_END: visualise
 
@@ -652,6 +843,11 @@ pub fn png_bytes(frame: &Frame, buffer: Buffer) -> Vec<u8> {
 /// (perceptual intent) where the bytes are sRGB-encoded, no colour chunk
 /// otherwise. Written by the `png` crate with the settings `image` uses for it.
 pub fn png_bytes_as(frame: &Frame, buffer: Buffer, png: PngEncoding) -> Vec<u8> {
+    encode_png(frame, buffer, png, &visualise_as(frame, buffer, png))
+}
+
+/// The PNG file of `buffer`'s picture `rgb` (see [`png_bytes_as`]).
+fn encode_png(frame: &Frame, buffer: Buffer, png: PngEncoding, rgb: &[u8]) -> Vec<u8> {
     let mut bytes = Vec::new();
     let mut encoder = png::Encoder::new(&mut bytes, frame.width, frame.height);
     encoder.set_color(png::ColorType::Rgb);
@@ -663,116 +859,281 @@ pub fn png_bytes_as(frame: &Frame, buffer: Buffer, png: PngEncoding) -> Vec<u8> 
     }
     encoder
         .write_header()
-        .and_then(|mut writer| writer.write_image_data(&visualise_as(frame, buffer, png)))
+        .and_then(|mut writer| writer.write_image_data(rgb))
         .expect("encoding a PNG into memory cannot fail");
     bytes
 }
 
+/// The PNG files of every buffer in `buffers`, each handed to `write` with its
+/// index as soon as it is encoded: the pictures drawn a few at a time in one pass
+/// over the records ([`PICTURES_AT_ONCE`] bytes of them), each few encoded in
+/// parallel.
+fn png_files(
+    frame: &Frame,
+    buffers: &[Buffer],
+    png: PngEncoding,
+    write: impl Fn(usize, &[u8]) -> Result<(), Error> + Sync,
+) -> Result<(), Error> {
+    let palette = Palette::new(frame, png, buffers);
+    let picture_bytes = (frame.pixels.len() * 3).max(1);
+    let at_once = (PICTURES_AT_ONCE / picture_bytes).clamp(1, buffers.len().max(1));
+    // Drawn in an order that puts together the buffers that share work: those of
+    // the primary ray, and the three Blinn-Phong terms.
+    let mut order: Vec<usize> = (0..buffers.len()).collect();
+    order.sort_by_key(|&k| DRAWING_ORDER.iter().position(|&b| b == buffers[k]));
+    for group in order.chunks(at_once) {
+        let chunk: Vec<Buffer> = group.iter().map(|&k| buffers[k]).collect();
+        let pictures = palette.pictures(&chunk);
+        pictures
+            .into_par_iter()
+            .zip(group)
+            .try_for_each(|(rgb, &k)| write(k, &encode_png(frame, buffers[k], png, &rgb)))?;
+    }
+    Ok(())
+}
+
+/// The order [`png_files`] draws the pictures in, a few at a time.
+const DRAWING_ORDER: [Buffer; 12] = [
+    Buffer::Direction,
+    Buffer::Position,
+    Buffer::Beauty,
+    Buffer::Depth,
+    Buffer::Normal,
+    Buffer::Shadow,
+    Buffer::Object,
+    Buffer::Bounces,
+    Buffer::Ambient,
+    Buffer::Diffuse,
+    Buffer::Specular,
+    Buffer::Rays,
+];
+
+/// How `--exr-compression` stores `buffers.exr`: the lossless schemes of
+/// OpenEXR that the `exr` crate writes (PXR24 and B44 would round float32
+/// samples). Every block is compressed in parallel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum ExrCompression {
+    /// Uncompressed: the fastest to write and to read, the largest file.
+    #[default]
+    None,
+    /// Run-length encoding of each scan line's bytes.
+    Rle,
+    /// Deflate, one scan line per block (OpenEXR's ZIPS).
+    Zips,
+    /// Deflate, 16 scan lines per block (OpenEXR's ZIP).
+    Zip,
+    /// Wavelet and Huffman coding, 32 scan lines per block (OpenEXR's PIZ).
+    Piz,
+}
+
+impl ExrCompression {
+    fn scheme(self) -> Compression {
+        match self {
+            ExrCompression::None => Compression::Uncompressed,
+            ExrCompression::Rle => Compression::RLE,
+            ExrCompression::Zips => Compression::ZIP1,
+            ExrCompression::Zip => Compression::ZIP16,
+            ExrCompression::Piz => Compression::PIZ,
+        }
+    }
+}
+
 // ANCHOR: exr
+/// The channels of `buffers.exr`, each with the buffer it belongs to, named so
+/// that Blender, Nuke, tev and OpenImageIO read every one: `R G B` and `Z` as
+/// the standard colour and depth, every other channel `layer.channel` (Blender's
+/// multilayer reader drops a channel whose name has no dot, or whose last part is
+/// more than one letter it does not know, with "unknown channel token").
+/// Vectors are `X Y Z`, colours `R G B`, and a buffer of one value has the one
+/// channel `X`, as Blender's own `IndexOB.X`. The order here is the order of
+/// [`exr_samples`]; the file lists them sorted by name.
+pub const EXR_CHANNELS: [(&str, Buffer); 26] = [
+    ("R", Buffer::Beauty),
+    ("G", Buffer::Beauty),
+    ("B", Buffer::Beauty),
+    ("dir.X", Buffer::Direction),
+    ("dir.Y", Buffer::Direction),
+    ("dir.Z", Buffer::Direction),
+    ("Z", Buffer::Depth),
+    ("N.X", Buffer::Normal),
+    ("N.Y", Buffer::Normal),
+    ("N.Z", Buffer::Normal),
+    ("P.X", Buffer::Position),
+    ("P.Y", Buffer::Position),
+    ("P.Z", Buffer::Position),
+    ("shadow.X", Buffer::Shadow),
+    ("object.X", Buffer::Object),
+    ("ambient.R", Buffer::Ambient),
+    ("ambient.G", Buffer::Ambient),
+    ("ambient.B", Buffer::Ambient),
+    ("diffuse.R", Buffer::Diffuse),
+    ("diffuse.G", Buffer::Diffuse),
+    ("diffuse.B", Buffer::Diffuse),
+    ("specular.R", Buffer::Specular),
+    ("specular.G", Buffer::Specular),
+    ("specular.B", Buffer::Specular),
+    ("bounces.X", Buffer::Bounces),
+    ("rays.X", Buffer::Rays),
+];
+
+/// Every sample of pixel (`row`, `col`), in the order of [`EXR_CHANNELS`]:
+/// beauty, direction, depth (+∞ on a miss), normal, position (`(0, 0, 0)` on a
+/// miss), shadow (1 lit, 0 shadowed, −1 missed), object (its index, −1 missed),
+/// the Blinn-Phong terms, bounces and rays.
+pub fn exr_samples(frame: &Frame, row: u32, col: u32) -> [f32; 26] {
+    let p = frame.at(row, col);
+    let (ray, terms) = (frame.ray_buffers(row, col), frame.terms(p));
+    std::array::from_fn(|k| exr_sample(k, p, &ray, &terms))
+}
+
+/// Sample `k` of [`exr_samples`], from the pixel's record, its primary ray's
+/// direction and position ([`Frame::ray_buffers`]) and its Blinn-Phong terms
+/// ([`Frame::terms`]).
+#[inline(always)]
+fn exr_sample(
+    k: usize,
+    p: &PixelRecord,
+    (direction, position): &([f32; 3], [f32; 3]),
+    terms: &[[f32; 3]; 3],
+) -> f32 {
+    match k {
+        0..=2 => p.colour[k],
+        3..=5 => direction[k - 3],
+        6 => p.depth,
+        7..=9 => p.normal[k - 7],
+        10..=12 => position[k - 10],
+        13 => p.shadow,
+        14 if p.object == NO_OBJECT => -1.0,
+        14 => p.object as f32,
+        15..=23 => terms[(k - 15) / 3][(k - 15) % 3],
+        24 => p.bounces as f32,
+        _ => p.rays as f32,
+    }
+}
+
 /// Write the EXR file of a frame to `writer`: one float32 channel per number of
-/// every buffer the frame has, named as compositing tools expect them. `R, G, B`:
-/// beauty; `dir.X, dir.Y, dir.Z`: ray direction; `Z`: depth (+∞ on a miss);
-/// `N.X, N.Y, N.Z`: normal; `shadow`: 1 lit, 0 shadowed, −1 missed; `object`: the
-/// object's index, −1 missed; `ambient.R` … `specular.B`: the Blinn-Phong terms;
-/// `bounces` and `rays`: counts. The samples are read from the frame as each scan
-/// line is written.
-pub fn exr_to<W: Write + Seek>(frame: &Frame, writer: W) -> exr::error::UnitResult {
-    let size = (frame.width as usize, frame.height as usize);
-    // Uncompressed. Float buffers barely compress, and exr's compressors are
-    // slow on them: at 1920 × 1080 (23 channels, 191 MB of samples) RLE saved 42 %
-    // of the file (110 MB) at about 0.3 s more per render on 2 cores, ZIP 74 %
-    // (50 MB) at about 1.1 s more (measured with raystep's release build,
-    // 2026-12-01).
+/// every buffer the frame has ([`EXR_CHANNELS`]), in scan lines, compressed as
+/// `compression` says. The blocks (1 to 32 scan lines) are laid out as the file
+/// stores them (each line's samples channel by channel) straight from the
+/// records, and compressed, a few dozen at a time, in parallel on rayon's
+/// threads; then written in order, so the bytes are the same on every run
+/// whatever the thread count.
+pub fn exr_to<W: Write + Seek>(
+    frame: &Frame,
+    writer: W,
+    compression: ExrCompression,
+) -> exr::error::UnitResult {
+    let size = Vec2(frame.width as usize, frame.height as usize);
+    let mut channels: Vec<(&str, usize)> = (EXR_CHANNELS.iter().enumerate())
+        .filter(|(_, (_, buffer))| frame.has(*buffer))
+        .map(|(index, (name, _))| (*name, index))
+        .collect();
+    // OpenEXR wants them sorted by name.
+    channels.sort_unstable_by_key(|(name, _)| name.as_bytes());
+    let descriptions = channels
+        .iter()
+        .map(|(name, _)| ChannelDescription::named(*name, SampleType::F32))
+        .collect();
     // Scan lines in increasing order keep the bytes the same on every run.
-    let encoding = Encoding {
-        compression: Compression::Uncompressed,
-        blocks: Blocks::ScanLines,
-        line_order: LineOrder::Increasing,
-    };
-    // A channel of each buffer the frame has; exr sorts them by name in the file.
-    let channel = |buffer: Buffer, name: &str| {
-        frame
-            .has(buffer)
-            .then(|| ChannelDescription::named(name, SampleType::F32))
-    };
-    let three = |buffer: Buffer, names: [&str; 3]| names.map(|n| channel(buffer, n));
-    let [r, g, b] = three(Buffer::Beauty, ["R", "G", "B"]);
-    let [dx, dy, dz] = three(Buffer::Direction, ["dir.X", "dir.Y", "dir.Z"]);
-    let [nx, ny, nz] = three(Buffer::Normal, ["N.X", "N.Y", "N.Z"]);
-    let [ar, ag, ab] = three(Buffer::Ambient, ["ambient.R", "ambient.G", "ambient.B"]);
-    let [dr, dg, db] = three(Buffer::Diffuse, ["diffuse.R", "diffuse.G", "diffuse.B"]);
-    let [sr, sg, sb] = three(Buffer::Specular, ["specular.R", "specular.G", "specular.B"]);
-    let names = (
-        r,
-        g,
-        b,
-        dx,
-        dy,
-        dz,
-        channel(Buffer::Depth, "Z"),
-        nx,
-        ny,
-        nz,
-        channel(Buffer::Shadow, "shadow"),
-        channel(Buffer::Object, "object"),
-        ar,
-        ag,
-        ab,
-        dr,
-        dg,
-        db,
-        sr,
-        sg,
-        sb,
-        channel(Buffer::Bounces, "bounces"),
-        channel(Buffer::Rays, "rays"),
-    );
-    let channels = SpecificChannels::new(names, |at: Vec2<usize>| {
-        let (row, col) = (at.y() as u32, at.x() as u32);
-        let p = frame.at(row, col);
-        let d = frame.direction(row, col);
-        let [c, n] = [p.colour, p.normal];
-        let [a, df, s] = frame.terms(p);
-        let object = if p.object == NO_OBJECT {
-            -1.0
-        } else {
-            p.object as f32
-        };
-        (
-            c[0],
-            c[1],
-            c[2],
-            d[0],
-            d[1],
-            d[2],
-            p.depth,
-            n[0],
-            n[1],
-            n[2],
-            p.shadow,
-            object,
-            a[0],
-            a[1],
-            a[2],
-            df[0],
-            df[1],
-            df[2],
-            s[0],
-            s[1],
-            s[2],
-            p.bounces as f32,
-            p.rays as f32,
-        )
-    });
-    let layer = Layer::new(size, LayerAttributes::default(), encoding, channels);
-    Image::from_layer(layer).write().to_buffered(writer)
+    let descriptions: SmallVec<[ChannelDescription; 5]> = descriptions;
+    let header = Header::new(Text::from(""), size, descriptions)
+        .with_attributes(LayerAttributes::default())
+        .with_shared_attributes(ImageAttributes::new(IntegerBounds::from_dimensions(size)))
+        .with_encoding(
+            compression.scheme(),
+            BlockDescription::ScanLines,
+            LineOrder::Increasing,
+        );
+    let order: Vec<usize> = channels.iter().map(|(_, index)| *index).collect();
+    exr::block::write(
+        writer,
+        SmallVec::from_iter([header]),
+        true,
+        |meta, chunks| {
+            let blocks: Vec<(usize, BlockIndex)> =
+                exr::block::enumerate_ordered_header_block_indices(&meta.headers).collect();
+            let lines = blocks.first().map_or(1, |(_, b)| b.pixel_size.height());
+            // About 8 MB of uncompressed blocks in flight, and a block per thread at
+            // least.
+            let line_bytes = size.width() * order.len() * 4;
+            let window = (8 << 20) / (line_bytes * lines).max(1);
+            let window = window.clamp(rayon::current_num_threads(), 256);
+            for some in blocks.chunks(window) {
+                let compressed: Vec<_> = some
+                    .par_iter()
+                    .map(|&(index_in_header, index)| {
+                        let data = exr_block(frame, &order, index);
+                        let block = exr::block::UncompressedBlock { index, data };
+                        block
+                            .compress_to_chunk(&meta.headers)
+                            .map(|chunk| (index_in_header, chunk))
+                    })
+                    .collect();
+                for chunk in compressed {
+                    let (index_in_header, chunk) = chunk?;
+                    chunks.write_chunk(index_in_header, chunk)?;
+                }
+            }
+            Ok(())
+        },
+    )
+}
+
+/// The uncompressed bytes of one block of scan lines: for each line, for each
+/// channel in file order (`order`, indices into [`exr_samples`]), the line's
+/// samples in native byte order (the crate's compressor makes them little-endian).
+fn exr_block(frame: &Frame, order: &[usize], index: BlockIndex) -> Vec<u8> {
+    let (x0, y0) = (index.pixel_position.x(), index.pixel_position.y());
+    let (width, lines) = (index.pixel_size.width(), index.pixel_size.height());
+    let mut data = vec![0u8; width * lines * order.len() * 4];
+    let mut channel_rows = data.chunks_exact_mut(width * 4);
+    let (mut rays, mut terms) = (Vec::with_capacity(width), Vec::with_capacity(width));
+    for row in y0..y0 + lines {
+        let pixels = &frame.pixels[row * frame.width as usize + x0..][..width];
+        let row = row as u32;
+        rays.clear();
+        terms.clear();
+        rays.extend((x0..x0 + width).map(|col| frame.ray_buffers(row, col as u32)));
+        terms.extend(pixels.iter().map(|p| frame.terms(p)));
+        // Channel after channel, each a loop along the line of its own (the
+        // channel's rule chosen once per line, not per sample).
+        for (&k, bytes) in order.iter().zip(&mut channel_rows) {
+            // The same numbers as `exr_sample` (tests/exr_readers.rs compares
+            // every sample); the rest through it.
+            match k {
+                0..=2 => fill_samples(bytes, |x| pixels[x].colour[k]),
+                3..=5 => fill_samples(bytes, |x| rays[x].0[k - 3]),
+                6 => fill_samples(bytes, |x| pixels[x].depth),
+                7..=9 => fill_samples(bytes, |x| pixels[x].normal[k - 7]),
+                10..=12 => fill_samples(bytes, |x| rays[x].1[k - 10]),
+                15..=23 => fill_samples(bytes, |x| terms[x][(k - 15) / 3][(k - 15) % 3]),
+                _ => fill_samples(bytes, |x| exr_sample(k, &pixels[x], &rays[x], &terms[x])),
+            }
+        }
+    }
+    data
+}
+
+/// Fill one channel's samples of a line, `sample(x)` at column `x`, as native
+/// float32 bytes.
+#[inline(always)]
+fn fill_samples(bytes: &mut [u8], sample: impl Fn(usize) -> f32) {
+    for (x, b) in bytes.chunks_exact_mut(4).enumerate() {
+        b.copy_from_slice(&sample(x).to_ne_bytes());
+    }
 }
 // ANCHOR_END: exr
 
-/// The EXR file of a frame, as bytes (for tests; renders stream it to the file).
+/// The EXR file of a frame, as bytes, uncompressed (for tests; renders stream it
+/// to the file).
 pub fn exr_bytes(frame: &Frame) -> Result<Vec<u8>, Error> {
+    exr_bytes_as(frame, ExrCompression::None)
+}
+
+/// The EXR file of a frame, as bytes, compressed as `compression` says.
+pub fn exr_bytes_as(frame: &Frame, compression: ExrCompression) -> Result<Vec<u8>, Error> {
     let mut bytes = Cursor::new(Vec::new());
-    exr_to(frame, &mut bytes).map_err(|e| Error::Output {
+    exr_to(frame, &mut bytes, compression).map_err(|e| Error::Output {
         path: PathBuf::from(EXR_FILE),
         message: format!("cannot encode the EXR: {e}"),
     })?;
@@ -780,14 +1141,20 @@ pub fn exr_bytes(frame: &Frame) -> Result<Vec<u8>, Error> {
 }
 
 /// Write the EXR file of a frame to `temporary`, reporting errors against `path`.
-fn write_exr(frame: &Frame, temporary: &Path, path: &Path) -> Result<(), Error> {
+fn write_exr(
+    frame: &Frame,
+    compression: ExrCompression,
+    temporary: &Path,
+    path: &Path,
+) -> Result<(), Error> {
     let fail = |message: String| Error::Output {
         path: path.to_path_buf(),
         message,
     };
     let file = create_new(temporary).map_err(|e| fail(e.to_string()))?;
     let mut writer = BufWriter::new(file);
-    exr_to(frame, &mut writer).map_err(|e| fail(format!("cannot write the EXR: {e}")))?;
+    exr_to(frame, &mut writer, compression)
+        .map_err(|e| fail(format!("cannot write the EXR: {e}")))?;
     writer.flush().map_err(|e| fail(e.to_string()))
 }
 

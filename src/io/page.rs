@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::aov::{Buffer, Frame, PixelRecord, NO_OBJECT};
+use crate::aov::{Buffer, Frame, NO_OBJECT};
 use crate::error::Error;
 use crate::io::output::Pending;
 
@@ -29,7 +29,8 @@ pub const INDEX_FILE: &str = "index.html";
 pub const PIXELS_FILE: &str = "pixels.js";
 
 /// The largest render whose numbers [`PIXELS_FILE`] holds: 1920 × 1080. Its
-/// file takes 59 bytes per pixel (122 MB at this size, per stage); above it the
+/// file takes 75 bytes per pixel (14 float32s in base64: 155 MB at this size,
+/// per stage); above it the
 /// page still shows the pictures, and says where to read the numbers instead.
 pub const NUMBERS_UP_TO: u64 = 1920 * 1080;
 
@@ -39,8 +40,9 @@ pub fn has_numbers(width: u32, height: u32) -> bool {
 }
 
 /// The floats of each pixel in [`PIXELS_FILE`], in order.
-pub const FIELDS: [&str; 11] = [
-    "R", "G", "B", "depth", "N.X", "N.Y", "N.Z", "shadow", "object", "bounces", "rays",
+pub const FIELDS: [&str; 14] = [
+    "R", "G", "B", "depth", "N.X", "N.Y", "N.Z", "P.X", "P.Y", "P.Z", "shadow", "object",
+    "bounces", "rays",
 ];
 
 const TEMPLATE: &str = include_str!("../../assets/page/index.html");
@@ -59,10 +61,13 @@ pub struct PageStage {
     pub buffers: Vec<String>,
 }
 
-/// The floats of one pixel, in the order of [`FIELDS`]. On a miss: depth `+∞`,
-/// normal `(0, 0, 0)`, shadow `−1`, object `−1` (as in `buffers.exr`).
-fn pixel_fields(p: &PixelRecord) -> [f32; 11] {
+/// The floats of pixel (`row`, `col`), in the order of [`FIELDS`]. On a miss:
+/// depth `+∞`, normal and position `(0, 0, 0)`, shadow `−1`, object `−1` (as in
+/// `buffers.exr`).
+fn pixel_fields(frame: &Frame, row: u32, col: u32) -> [f32; 14] {
+    let p = frame.at(row, col);
     let [r, g, b] = p.colour;
+    let [px, py, pz] = frame.position(row, col);
     let [nx, ny, nz] = p.normal;
     let object = if p.object == NO_OBJECT {
         -1.0
@@ -71,7 +76,7 @@ fn pixel_fields(p: &PixelRecord) -> [f32; 11] {
     };
     let (bounces, rays) = (p.bounces as f32, p.rays as f32);
     [
-        r, g, b, p.depth, nx, ny, nz, p.shadow, object, bounces, rays,
+        r, g, b, p.depth, nx, ny, nz, px, py, pz, p.shadow, object, bounces, rays,
     ]
 }
 
@@ -86,14 +91,14 @@ pub fn pixels_js(folder: &str, frame: &Frame) -> String {
         "raystepPixels.load({folder}, {{\"width\": {}, \"height\": {}, \"fields\": {fields}, \"data\": \"",
         frame.width, frame.height
     ));
-    // Three pixels are 132 bytes, a multiple of 3: encoded 3 × 256 pixels at a
+    // Three pixels are 168 bytes, a multiple of 3: encoded 3 × 256 pixels at a
     // time, the base64 is the same as the whole at once, without holding all the
     // bytes.
     const GROUP: usize = 256 * 3 * FIELDS.len() * 4;
     let mut group = Vec::with_capacity(GROUP);
     for row in 0..frame.height {
         for col in 0..frame.width {
-            for v in pixel_fields(frame.at(row, col)) {
+            for v in pixel_fields(frame, row, col) {
                 group.extend_from_slice(&v.to_le_bytes());
             }
             if group.len() == GROUP {
@@ -222,26 +227,26 @@ mod tests {
         let frame = frame(7, 5, Stage::Plane);
         let js = pixels_js("06-plane", &frame);
         let prefix = "raystepPixels.load(\"06-plane\", {\"width\": 7, \"height\": 5, \"fields\": \
-            [\"R\",\"G\",\"B\",\"depth\",\"N.X\",\"N.Y\",\"N.Z\",\"shadow\",\"object\",\"bounces\",\"rays\"], \
+            [\"R\",\"G\",\"B\",\"depth\",\"N.X\",\"N.Y\",\"N.Z\",\"P.X\",\"P.Y\",\"P.Z\",\"shadow\",\"object\",\"bounces\",\"rays\"], \
             \"data\": \"";
         let start = js.find(prefix).expect("the call") + prefix.len();
         let end = js.rfind("\"});").expect("the end of the call");
         let bytes: Vec<u8> = (0..frame.height)
             .flat_map(|row| (0..frame.width).map(move |col| (row, col)))
-            .flat_map(|(row, col)| pixel_fields(frame.at(row, col)))
+            .flat_map(|(row, col)| pixel_fields(&frame, row, col))
             .flat_map(f32::to_le_bytes)
             .collect();
-        assert_eq!(bytes.len(), 35 * 11 * 4);
+        assert_eq!(bytes.len(), 35 * 14 * 4);
         assert_eq!(&js[start..end], base64(&bytes));
     }
 
     #[test]
     fn a_miss_reads_infinite_depth_zero_normal_and_minus_one() {
         let frame = frame(7, 5, Stage::Plane);
-        let miss = frame.at(0, 0);
-        assert!(!miss.is_hit(), "the top-left corner sees the sky");
-        let [.., depth, nx, ny, nz, shadow, object, _, _] = pixel_fields(miss);
+        assert!(!frame.at(0, 0).is_hit(), "the top-left corner sees the sky");
+        let [.., depth, nx, ny, nz, px, py, pz, shadow, object, _, _] = pixel_fields(&frame, 0, 0);
         assert_eq!((depth, [nx, ny, nz]), (f32::INFINITY, [0.0; 3]));
+        assert_eq!([px, py, pz], [0.0; 3]);
         assert_eq!((shadow, object), (-1.0, -1.0));
     }
 

@@ -38,6 +38,11 @@ pub struct Explanation {
     pub primary: RayInfo,
     /// Distance along the primary ray to its first hit; `None` on a miss.
     pub depth: Option<f64>,
+    /// `P`, the first hit's point as the `position` buffer holds it: the primary
+    /// ray walked the depth the record keeps (float32), in float32 (the hit's
+    /// `point` is the one the trace computed); `None` on a miss, where the buffer
+    /// holds `(0, 0, 0)`.
+    pub position: Option<[f64; 3]>,
     /// Each segment of the path: the primary ray, then its reflections.
     pub segments: Vec<Segment>,
     /// Why the path ended.
@@ -197,6 +202,7 @@ fn explain_in<T: Real>(scene: &Scene, settings: &Settings, x: u32, y: u32) -> Ex
                 direction: [0.0; 3],
             },
             depth: None,
+            position: None,
             segments: Vec::new(),
             end: String::new(),
             unclipped: [0.0; 3],
@@ -225,6 +231,12 @@ fn explain_in<T: Real>(scene: &Scene, settings: &Settings, x: u32, y: u32) -> Ex
         return told;
     }
     told.unclipped = sum.to_f64().to_array();
+    // As `Frame::position` computes it, from the depth the record keeps.
+    told.position = told.depth.map(|depth| {
+        let ray = tracer.camera.primary_ray::<T>(row, col);
+        let at = ray.at(T::of(f64::from(depth as f32)));
+        at.to_f64().as_vec3().as_dvec3().to_array()
+    });
     if settings.spp > 1 {
         let mut all = rays;
         let mean = crate::render::samples_mean(&tracer, row, col, settings.spp, &mut all);
@@ -548,6 +560,13 @@ impl std::fmt::Display for Explanation {
             };
             writeln!(f, "  nearest: object {} at t = {}", h.object, num(h.t))?;
             writeln!(f, "  point   {}", vec3(h.point))?;
+            if let (0, Some(p)) = (s.index, self.position) {
+                writeln!(
+                    f,
+                    "  position buffer P = {}  (the point again, from the depth in float32)",
+                    vec3(p)
+                )?;
+            }
             writeln!(f, "  normal  {}", vec3(h.normal))?;
             writeln!(
                 f,
