@@ -10,7 +10,8 @@
 # with every stage and with primary and shadow rays only (`--without reflection`).
 # Needs Debian's libembree-dev and g++ (apt-get install libembree-dev g++). The
 # program is built into $CARGO_TARGET_DIR/embree/spheres (target/embree/spheres);
-# `raystep chart --scale --embree PATH` runs it beside raystep's points.
+# `raystep chart --scale --embree PATH` runs it beside raystep's points. With
+# RAYSTEP=path/to/raystep, that binary is timed (and this tree's is not built).
 #
 # Prints one line per round and measurement, then for each scene the min–max over
 # the rounds of both programs' rays per second and of their ratio (raystep's rays
@@ -41,9 +42,12 @@ shift $(($# < 2 ? $# : 2))
 counts=("$@")
 [[ ${#counts[@]} -gt 0 ]] || counts=(10 1000 100000)
 
-(cd "$root" && cargo build --release --quiet)
+# RAYSTEP=path/to/raystep times that binary instead of building this tree's.
+if [[ -z ${RAYSTEP:-} ]]; then
+  (cd "$root" && cargo build --release --quiet)
+fi
+raystep=${RAYSTEP:-$target/release/raystep}
 build
-raystep=$target/release/raystep
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 threads=$(nproc)
