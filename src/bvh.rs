@@ -1,13 +1,19 @@
 //! A bounding volume hierarchy: boxes around groups of spheres, boxes around
 //! groups of boxes, so that a ray tests only the spheres whose boxes it crosses.
 //!
-//! **Build.** Every sphere gets its axis-aligned box. The set is split in two at
-//! the median of the box centres along the axis where the centres spread most,
-//! and each half again, until at most [`LEAF`] spheres remain. The median split
-//! builds in O(n log n), never makes an empty child, and keeps the tree depth at
-//! log₂(n / LEAF), so a fixed traversal stack always suffices. (A split by the
-//! surface area heuristic makes slightly better trees for uneven scenes; for the
-//! evenly spread spheres raystep generates, the median is as good and simpler.)
+//! **Build.** Every sphere gets its axis-aligned box. A node's spheres are
+//! sorted by their box centres into `BINS` bins along each axis and split
+//! between the two bins where the surface area heuristic is least: the sum over
+//! both sides of the side's box area (how likely a ray that crosses the node is to
+//! cross it) times its number of spheres. Each side is split again, until at most
+//! [`LEAF`] spheres remain. The binned heuristic builds in O(n log n), makes
+//! better trees than a split at the median where spheres cluster, and never an
+//! empty child; from depth `SAH_DEPTH` on the median takes over, which keeps
+//! the depth below 64, so a fixed traversal stack always suffices. Subtrees of
+//! `PARALLEL_FROM` spheres or more are built on rayon's threads into lists of
+//! their own, joined in a fixed order: the tree depends on the spheres alone, not
+//! on the thread count. The spheres are partitioned in place in one list, so each
+//! leaf's spheres are a slice of it and no node allocates.
 //!
 //! **Traversal.** A ray enters the root's box; at a node it visits the nearer child
 //! first and skips any box it enters beyond the nearest hit found so far. Objects
@@ -17,8 +23,8 @@
 //! The result is the plain loop's: the same object at the same distance, ties
 //! going to the lower index as the plain loop's strict `<` gives them (a test
 //! renders both ways and compares the bytes). Boxes are computed in float64,
-//! widened by a relative 1e-9, far more than their rounding, then widened once
-//! more and kept in float32, rounded outwards ([`Bvh::build`]): the one-ray walk
+//! widened by a relative 1e-9, far more than their rounding, rounded outwards to
+//! float32, joined, then widened once more and kept in float32, rounded outwards ([`Bvh::build`]): the one-ray walk
 //! tests them in float64, and four rays test them in float32, half the work of
 //! float64 lanes, unless a ray starts too far out (`Bvh::enter_packet`, in
 //! `src/fast/walk.rs`). A node is
@@ -130,21 +136,6 @@ const SAH_DEPTH: usize = 32;
 /// ones on the thread that reached them. The tree is the same either way.
 const PARALLEL_FROM: usize = 8192;
 
-/// How a node's spheres are divided between its two children.
-#[derive(Clone, Copy)]
-enum Split {
-    /// Those whose centre falls in one of the first `bin + 1` of [`BINS`]
-    /// bins of `axis` over `low..low + BINS / scale` go first.
-    Binned {
-        axis: usize,
-        bin: usize,
-        low: f32,
-        scale: f32,
-    },
-    /// The first half by centre along `axis` (ties by object index) go first.
-    Median { axis: usize },
-}
-
 /// Which of the [`BINS`] bins the centre coordinate `c` falls in.
 #[inline]
 fn bin_of(c: f32, low: f32, scale: f32) -> usize {
@@ -179,15 +170,6 @@ impl Bounds {
     fn half_area(&self) -> f64 {
         let d = (self.max - self.min).max(glam::Vec3::ZERO).as_dvec3();
         d.x * d.y + d.y * d.z + d.z * d.x
-    }
-
-    /// The box of `items`.
-    fn of(items: &[Item]) -> Bounds {
-        let mut b = Bounds::EMPTY;
-        for i in items {
-            b.add(i.min, i.max);
-        }
-        b
     }
 
     /// The node of this box widened by `widen` (rounded outwards to float32).
@@ -243,7 +225,8 @@ impl Bvh {
         let nodes = if items.is_empty() {
             Vec::new()
         } else {
-            subtree(&mut items, 0, 0, widen)
+            let span = Span::of(&items);
+            subtree(&mut items, span, 0, 0, widen)
         };
         // The leaves' spheres in the order of the tree: each leaf's run of `items`
         // is its slice of the partitioned list.
@@ -451,27 +434,62 @@ impl Bvh {
     }
 }
 
-/// The nodes of the subtree over `items`, the slice of the build's list that
-/// starts at `offset`, at `depth` in the tree: depth first, each node's first
-/// child right after it, its second child's index (`first`) counted from the
-/// subtree's root. The two children of a large subtree are built in parallel,
-/// each into a list of its own, and joined; a small one is grown into one list
-/// ([`grow`]).
-fn subtree(items: &mut [Item], offset: usize, depth: usize, widen: f64) -> Vec<Node> {
+/// The box of some spheres and the box of their centres.
+#[derive(Clone, Copy)]
+struct Span {
+    bounds: Bounds,
+    centres: Bounds,
+}
+
+impl Span {
+    const EMPTY: Span = Span {
+        bounds: Bounds::EMPTY,
+        centres: Bounds::EMPTY,
+    };
+
+    #[inline]
+    fn add(&mut self, item: &Item) {
+        self.bounds.add(item.min, item.max);
+        let c = item.centre();
+        self.centres.add(c, c);
+    }
+
+    #[inline]
+    fn join(&mut self, other: &Span) {
+        self.bounds.join(&other.bounds);
+        self.centres.join(&other.centres);
+    }
+
+    /// The span of `items`.
+    fn of(items: &[Item]) -> Span {
+        let mut span = Span::EMPTY;
+        for i in items {
+            span.add(i);
+        }
+        span
+    }
+}
+
+/// The nodes of the subtree over `items` (of span `span`), the slice of the
+/// build's list that starts at `offset`, at `depth` in the tree: depth first,
+/// each node's first child right after it, its second child's index (`first`)
+/// counted from the subtree's root. The two children of a large subtree are
+/// built in parallel, each into a list of its own, and joined; a small one is
+/// grown into one list ([`grow`]).
+fn subtree(items: &mut [Item], span: Span, offset: usize, depth: usize, widen: f64) -> Vec<Node> {
     if items.len() < PARALLEL_FROM {
-        let mut nodes = Vec::with_capacity(items.len() / 2 + 1);
-        grow(items, offset, depth, widen, &mut nodes);
+        let mut nodes = Vec::with_capacity(items.len());
+        grow(items, span, offset, depth, widen, &mut nodes);
         return nodes;
     }
-    let (bounds, split) = plan(items, depth);
-    let middle = partition(items, split);
+    let (middle, spans) = divide(items, &span, depth);
     let (left, right) = items.split_at_mut(middle);
     let (a, b) = rayon::join(
-        || subtree(left, offset, depth + 1, widen),
-        || subtree(right, offset + middle, depth + 1, widen),
+        || subtree(left, spans[0], offset, depth + 1, widen),
+        || subtree(right, spans[1], offset + middle, depth + 1, widen),
     );
     let mut nodes = Vec::with_capacity(1 + a.len() + b.len());
-    nodes.push(bounds.node(widen, (1 + a.len()) as u32, 0));
+    nodes.push(span.bounds.node(widen, (1 + a.len()) as u32, 0));
     for part in [a, b] {
         let base = nodes.len() as u32;
         nodes.extend(part.into_iter().map(|mut n| {
@@ -484,139 +502,105 @@ fn subtree(items: &mut [Item], offset: usize, depth: usize, widen: f64) -> Vec<N
     nodes
 }
 
-/// Add the subtree over `items` (the slice of the build's list from `offset`) to
-/// `nodes`, depth first.
-fn grow(items: &mut [Item], offset: usize, depth: usize, widen: f64, nodes: &mut Vec<Node>) {
+/// Add the subtree over `items` (of span `span`, the slice of the build's list
+/// from `offset`) to `nodes`, depth first.
+fn grow(
+    items: &mut [Item],
+    span: Span,
+    offset: usize,
+    depth: usize,
+    widen: f64,
+    nodes: &mut Vec<Node>,
+) {
     if items.len() <= LEAF {
-        nodes.push(Bounds::of(items).node(widen, offset as u32, items.len() as u32));
+        nodes.push(span.bounds.node(widen, offset as u32, items.len() as u32));
         return;
     }
-    let (bounds, split) = plan(items, depth);
-    let middle = partition(items, split);
+    let (middle, spans) = divide(items, &span, depth);
     let at = nodes.len();
-    nodes.push(bounds.node(widen, 0, 0));
+    nodes.push(span.bounds.node(widen, 0, 0));
     let (left, right) = items.split_at_mut(middle);
-    grow(left, offset, depth + 1, widen, nodes);
+    grow(left, spans[0], offset, depth + 1, widen, nodes);
     nodes[at].first = nodes.len() as u32;
-    grow(right, offset + middle, depth + 1, widen, nodes);
+    grow(right, spans[1], offset + middle, depth + 1, widen, nodes);
 }
 
-/// The box of `items` and how to split them: by the surface area heuristic
-/// over [`BINS`] bins of the box centres on each axis (the split that
-/// minimises each side's area times its number of spheres; the first such in
-/// the order x, y, z and low to high), or at the median along the axis where
-/// the centres spread most from depth [`SAH_DEPTH`] on or where every centre is
-/// the same.
-fn plan(items: &[Item], depth: usize) -> (Bounds, Split) {
-    let mut bounds = Bounds::EMPTY;
-    let mut centres = Bounds::EMPTY;
-    for i in items {
-        bounds.add(i.min, i.max);
-        let c = i.centre();
-        centres.add(c, c);
-    }
-    let spread = centres.max - centres.min;
-    let widest = if spread.x >= spread.y && spread.x >= spread.z {
+/// Split `items` (of span `span`) in two, in place: the spheres of the first
+/// child first. Returns how many those are (never 0 nor all) and the two
+/// children's spans.
+///
+/// The split is by the surface area heuristic over [`BINS`] bins of the box
+/// centres along the axis where they spread most: the boundary between two bins
+/// that minimises each side's box area times its number of spheres (the lowest
+/// such). From depth [`SAH_DEPTH`] on, or where every centre is the same, it is
+/// at the median along that axis instead.
+fn divide(items: &mut [Item], span: &Span, depth: usize) -> (usize, [Span; 2]) {
+    let spread = span.centres.max - span.centres.min;
+    let axis = if spread.x >= spread.y && spread.x >= spread.z {
         0
     } else if spread.y >= spread.z {
         1
     } else {
         2
     };
-    let median = Split::Median { axis: widest };
-    if depth >= SAH_DEPTH {
-        return (bounds, median);
+    let low = span.centres.min[axis];
+    let scale = BINS as f32 / spread[axis];
+    if depth >= SAH_DEPTH || !(spread[axis] > 0.0 && scale.is_finite()) {
+        let middle = items.len() / 2;
+        items.select_nth_unstable_by(middle, |a, b| {
+            a.centre()[axis]
+                .total_cmp(&b.centre()[axis])
+                .then(a.index.cmp(&b.index))
+        });
+        let (left, right) = items.split_at(middle);
+        return (middle, [Span::of(left), Span::of(right)]);
     }
-    let low = centres.min;
-    let scale = spread.to_array().map(|s| {
-        let scale = BINS as f32 / s;
-        if s > 0.0 && scale.is_finite() {
-            scale
-        } else {
-            0.0
-        }
-    });
-    let mut boxes = [[Bounds::EMPTY; BINS]; 3];
-    let mut counts = [[0u32; BINS]; 3];
-    for i in items {
-        let c = i.centre();
-        for axis in 0..3 {
-            let k = bin_of(c[axis], low[axis], scale[axis]);
-            counts[axis][k] += 1;
-            boxes[axis][k].add(i.min, i.max);
-        }
+    let mut bins = [Span::EMPTY; BINS];
+    let mut counts = [0u32; BINS];
+    for i in items.iter() {
+        let k = bin_of(i.centre()[axis], low, scale);
+        counts[k] += 1;
+        bins[k].add(i);
     }
-    let mut best = (f64::INFINITY, median);
-    for axis in 0..3 {
-        if scale[axis] == 0.0 {
+    // The area of the bins from k on, for each k.
+    let mut right_area = [0.0; BINS];
+    let mut right = Bounds::EMPTY;
+    for k in (1..BINS).rev() {
+        right.join(&bins[k].bounds);
+        right_area[k] = right.half_area();
+    }
+    let mut best = (f64::INFINITY, 0);
+    let mut left = Bounds::EMPTY;
+    let mut on_left = 0usize;
+    for k in 0..BINS - 1 {
+        left.join(&bins[k].bounds);
+        on_left += counts[k] as usize;
+        let on_right = items.len() - on_left;
+        if on_left == 0 || on_right == 0 {
             continue;
         }
-        // The area of the bins from k on, for each k.
-        let mut right_area = [0.0; BINS];
-        let mut right = Bounds::EMPTY;
-        for k in (1..BINS).rev() {
-            right.join(&boxes[axis][k]);
-            right_area[k] = right.half_area();
-        }
-        let mut left = Bounds::EMPTY;
-        let mut on_left = 0usize;
-        for k in 0..BINS - 1 {
-            left.join(&boxes[axis][k]);
-            on_left += counts[axis][k] as usize;
-            let on_right = items.len() - on_left;
-            if on_left == 0 || on_right == 0 {
-                continue;
-            }
-            let cost = left.half_area() * on_left as f64 + right_area[k + 1] * on_right as f64;
-            if cost < best.0 {
-                let (low, scale) = (low[axis], scale[axis]);
-                best = (
-                    cost,
-                    Split::Binned {
-                        axis,
-                        bin: k,
-                        low,
-                        scale,
-                    },
-                );
-            }
+        let cost = left.half_area() * on_left as f64 + right_area[k + 1] * on_right as f64;
+        if cost < best.0 {
+            best = (cost, k);
         }
     }
-    (bounds, best.1)
-}
-
-/// Put the spheres of the first child first, in place, and return how many
-/// there are (never 0 nor all).
-fn partition(items: &mut [Item], split: Split) -> usize {
-    match split {
-        Split::Binned {
-            axis,
-            bin,
-            low,
-            scale,
-        } => {
-            let first = |i: &Item| bin_of(i.centre()[axis], low, scale) <= bin;
-            let (mut i, mut j) = (0, items.len());
-            while i < j {
-                if first(&items[i]) {
-                    i += 1;
-                } else {
-                    j -= 1;
-                    items.swap(i, j);
-                }
-            }
-            i
-        }
-        Split::Median { axis } => {
-            let middle = items.len() / 2;
-            items.select_nth_unstable_by(middle, |a, b| {
-                a.centre()[axis]
-                    .total_cmp(&b.centre()[axis])
-                    .then(a.index.cmp(&b.index))
-            });
-            middle
+    // The lowest and the highest centre fall in the first and the last bin, so
+    // some boundary has spheres on both sides.
+    let bin = best.1;
+    let mut spans = [Span::EMPTY; 2];
+    for (k, b) in bins.iter().enumerate() {
+        spans[usize::from(k > bin)].join(b);
+    }
+    let (mut i, mut j) = (0, items.len());
+    while i < j {
+        if bin_of(items[i].centre()[axis], low, scale) <= bin {
+            i += 1;
+        } else {
+            j -= 1;
+            items.swap(i, j);
         }
     }
+    (i, spans)
 }
 
 /// The largest float32 not above `x`.
