@@ -105,24 +105,24 @@ pub(crate) struct Slabs {
 const FAST_PAD: f64 = 32.0;
 
 /// A sphere while the tree is built: its box (the float64 box rounded outwards
-/// to float32, 28 bytes in all, so that the passes over a million of them move
-/// little memory) and its object index.
+/// to float32, in SIMD registers: one instruction takes the minimum of two
+/// corners) and its object index.
 #[derive(Clone, Copy)]
 struct Item {
-    min: glam::Vec3,
-    max: glam::Vec3,
+    min: glam::Vec3A,
+    max: glam::Vec3A,
     index: u32,
 }
 
 impl Item {
     /// The centre of the box, by which spheres are sorted into bins.
     #[inline]
-    fn centre(&self) -> glam::Vec3 {
+    fn centre(&self) -> glam::Vec3A {
         (self.min + self.max) * 0.5
     }
 }
 
-/// Bins per axis of the surface area heuristic ([`Bvh::plan`]).
+/// Bins of the surface area heuristic ([`divide`]).
 const BINS: usize = 16;
 
 /// From this depth on, a node is split at the median, whatever the surface area
@@ -145,18 +145,18 @@ fn bin_of(c: f32, low: f32, scale: f32) -> usize {
 /// A box, growing as spheres are added.
 #[derive(Clone, Copy)]
 struct Bounds {
-    min: glam::Vec3,
-    max: glam::Vec3,
+    min: glam::Vec3A,
+    max: glam::Vec3A,
 }
 
 impl Bounds {
     const EMPTY: Bounds = Bounds {
-        min: glam::Vec3::INFINITY,
-        max: glam::Vec3::NEG_INFINITY,
+        min: glam::Vec3A::INFINITY,
+        max: glam::Vec3A::NEG_INFINITY,
     };
 
     #[inline]
-    fn add(&mut self, min: glam::Vec3, max: glam::Vec3) {
+    fn add(&mut self, min: glam::Vec3A, max: glam::Vec3A) {
         (self.min, self.max) = (self.min.min(min), self.max.max(max));
     }
 
@@ -168,7 +168,7 @@ impl Bounds {
     /// Half the surface area (0 for an empty box).
     #[inline]
     fn half_area(&self) -> f64 {
-        let d = (self.max - self.min).max(glam::Vec3::ZERO).as_dvec3();
+        let d = (self.max - self.min).max(glam::Vec3A::ZERO).as_dvec3();
         d.x * d.y + d.y * d.z + d.z * d.x
     }
 
