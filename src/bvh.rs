@@ -723,8 +723,7 @@ mod tests {
     #[test]
     fn the_tree_is_the_same_on_one_thread_and_on_many() {
         // Large enough for the parallel build (PARALLEL_FROM), on pools of 1 and 3.
-        let objects = crate::tools::generate::scene(3 * PARALLEL_FROM, 5)
-            .objects_in_play(crate::stages::Stages::ALL);
+        let objects = crate::tools::generate::scene(3 * PARALLEL_FROM, 5).objects;
         let build = |threads| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
