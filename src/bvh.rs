@@ -1,13 +1,19 @@
 //! A bounding volume hierarchy: boxes around groups of spheres, boxes around
 //! groups of boxes, so that a ray tests only the spheres whose boxes it crosses.
 //!
-//! **Build.** Every sphere gets its axis-aligned box. The set is split in two at
-//! the median of the box centres along the axis where the centres spread most,
-//! and each half again, until at most [`LEAF`] spheres remain. The median split
-//! builds in O(n log n), never makes an empty child, and keeps the tree depth at
-//! log₂(n / LEAF), so a fixed traversal stack always suffices. (A split by the
-//! surface area heuristic makes slightly better trees for uneven scenes; for the
-//! evenly spread spheres raystep generates, the median is as good and simpler.)
+//! **Build.** Every sphere gets its axis-aligned box. A node's spheres are
+//! sorted by their box centres into `BINS` bins along each axis and split
+//! between the two bins where the surface area heuristic is least: the sum over
+//! both sides of the side's box area (how likely a ray that crosses the node is to
+//! cross it) times its number of spheres. Each side is split again, until at most
+//! [`LEAF`] spheres remain. The binned heuristic builds in O(n log n), makes
+//! better trees than a split at the median where spheres cluster, and never an
+//! empty child; from depth `SAH_DEPTH` on the median takes over, which keeps
+//! the depth below 64, so a fixed traversal stack always suffices. Subtrees of
+//! `PARALLEL_FROM` spheres or more are built on rayon's threads into lists of
+//! their own, joined in a fixed order: the tree depends on the spheres alone, not
+//! on the thread count. The spheres are partitioned in place in one list, so each
+//! leaf's spheres are a slice of it and no node allocates.
 //!
 //! **Traversal.** A ray enters the root's box; at a node it visits the nearer child
 //! first and skips any box it enters beyond the nearest hit found so far. Objects
@@ -17,8 +23,8 @@
 //! The result is the plain loop's: the same object at the same distance, ties
 //! going to the lower index as the plain loop's strict `<` gives them (a test
 //! renders both ways and compares the bytes). Boxes are computed in float64,
-//! widened by a relative 1e-9, far more than their rounding, then widened once
-//! more and kept in float32, rounded outwards ([`Bvh::build`]): the one-ray walk
+//! widened by a relative 1e-9, far more than their rounding, rounded outwards to
+//! float32, joined, then widened once more and kept in float32, rounded outwards ([`Bvh::build`]): the one-ray walk
 //! tests them in float64, and four rays test them in float32, half the work of
 //! float64 lanes, unless a ray starts too far out (`Bvh::enter_packet`, in
 //! `src/fast/walk.rs`). A node is
@@ -98,14 +104,84 @@ pub(crate) struct Slabs {
 /// (see `Bvh::enter_packet`, in `src/fast/walk.rs`).
 const FAST_PAD: f64 = 32.0;
 
-/// A sphere while the tree is built: its index, box and box centre.
+/// A sphere while the tree is built: its box (the float64 box rounded outwards
+/// to float32, in SIMD registers: one instruction takes the minimum of two
+/// corners) and its object index.
 #[derive(Clone, Copy)]
 struct Item {
+    min: glam::Vec3A,
+    max: glam::Vec3A,
     index: u32,
-    min: Vec3,
-    max: Vec3,
-    centre: Vec3,
-    radius: f64,
+}
+
+impl Item {
+    /// The centre of the box, by which spheres are sorted into bins.
+    #[inline]
+    fn centre(&self) -> glam::Vec3A {
+        (self.min + self.max) * 0.5
+    }
+}
+
+/// Bins of the surface area heuristic ([`divide`]).
+const BINS: usize = 16;
+
+/// From this depth on, a node is split at the median, whatever the surface area
+/// heuristic would choose: the median keeps the rest of the tree within
+/// log₂(n / [`LEAF`]) + 1 < 32 more levels for any n below 2³², so that no walk
+/// of the tree needs more than the 64 entries of its fixed stack.
+const SAH_DEPTH: usize = 32;
+
+/// Subtrees of at least this many spheres are built on rayon's threads (their two
+/// children in parallel, each into a list of its own, joined in order); smaller
+/// ones on the thread that reached them. The tree is the same either way.
+const PARALLEL_FROM: usize = 8192;
+
+/// Which of the [`BINS`] bins the centre coordinate `c` falls in.
+#[inline]
+fn bin_of(c: f32, low: f32, scale: f32) -> usize {
+    (((c - low) * scale) as usize).min(BINS - 1)
+}
+
+/// A box, growing as spheres are added.
+#[derive(Clone, Copy)]
+struct Bounds {
+    min: glam::Vec3A,
+    max: glam::Vec3A,
+}
+
+impl Bounds {
+    const EMPTY: Bounds = Bounds {
+        min: glam::Vec3A::INFINITY,
+        max: glam::Vec3A::NEG_INFINITY,
+    };
+
+    #[inline]
+    fn add(&mut self, min: glam::Vec3A, max: glam::Vec3A) {
+        (self.min, self.max) = (self.min.min(min), self.max.max(max));
+    }
+
+    #[inline]
+    fn join(&mut self, other: &Bounds) {
+        self.add(other.min, other.max);
+    }
+
+    /// Half the surface area (0 for an empty box).
+    #[inline]
+    fn half_area(&self) -> f64 {
+        let d = (self.max - self.min).max(glam::Vec3A::ZERO).as_dvec3();
+        d.x * d.y + d.y * d.z + d.z * d.x
+    }
+
+    /// The node of this box widened by `widen` (rounded outwards to float32).
+    fn node(&self, widen: f64, first: u32, count: u32) -> Node {
+        let (min, max) = (self.min.as_dvec3() - widen, self.max.as_dvec3() + widen);
+        Node {
+            min: min.to_array().map(below).into(),
+            max: max.to_array().map(above).into(),
+            first,
+            count,
+        }
+    }
 }
 
 impl Bvh {
@@ -116,93 +192,61 @@ impl Bvh {
     /// quadratic's rounding can report hits far outside a sphere; a box would hide
     /// them and change the picture, so the tracer uses no BVH with `--intersect
     /// naive`.)
+    ///
+    /// The tree depends only on the objects: built on one thread or many, it is
+    /// the same, node for node.
     pub fn build<T: Real>(objects: &[Object<T>]) -> Bvh {
         let mut items = Vec::with_capacity(objects.len());
         let mut loose = Vec::new();
+        let mut largest = 0.0f64;
         for (i, o) in objects.iter().enumerate() {
             match o.shape {
                 Shape::Sphere(s) if o.role == Role::Sphere => {
                     let (c, r) = (s.center.to_f64(), s.radius.to_f64());
                     let half = Vec3::splat(r + 1e-9 * (r + c.abs().max_element()));
+                    let (min, max) = (c - half, c + half);
+                    largest = largest
+                        .max(min.abs().max_element())
+                        .max(max.abs().max_element());
                     items.push(Item {
+                        min: min.to_array().map(below).into(),
+                        max: max.to_array().map(above).into(),
                         index: i as u32,
-                        min: c - half,
-                        max: c + half,
-                        centre: c,
-                        radius: r,
                     });
                 }
                 _ => loose.push(i as u32),
             }
         }
-        let largest = items.iter().fold(0.0f64, |m, i| {
-            m.max(i.min.abs().max_element())
-                .max(i.max.abs().max_element())
-        });
         let reach = 2.0 * largest;
         // Below float32's normal numbers the rounding of an origin is not relative
         // (and the bound of `Bvh::enter_packet`, in src/fast/walk.rs, fails): such a tree is walked in float64.
         let fast_reach = if largest < 1e-30 { -1.0 } else { below(reach) };
-        let mut bvh = Bvh {
-            nodes: Vec::with_capacity(2 * items.len() / LEAF + 1),
-            items: Vec::with_capacity(items.len()),
-            balls: Vec::with_capacity(items.len()),
+        let widen = FAST_PAD * f64::from(f32::EPSILON / 2.0) * reach;
+        let nodes = if items.is_empty() {
+            Vec::new()
+        } else {
+            let span = Span::of(&items);
+            subtree(&mut items, span, 0, 0, widen)
+        };
+        // The leaves' spheres in the order of the tree: each leaf's run of `items`
+        // is its slice of the partitioned list.
+        Bvh {
+            nodes,
+            items: items.iter().map(|i| i.index).collect(),
+            balls: items
+                .iter()
+                .map(|i| match objects[i.index as usize].shape {
+                    Shape::Sphere(s) => {
+                        let c = s.center.to_f64();
+                        [c.x, c.y, c.z, s.radius.to_f64()]
+                    }
+                    Shape::Plane(_) => unreachable!("only spheres are in the tree"),
+                })
+                .collect(),
             loose,
             fast_reach,
             size: largest,
-        };
-        let widen = FAST_PAD * f64::from(f32::EPSILON / 2.0) * reach;
-        if !items.is_empty() {
-            bvh.split(&mut items, widen);
         }
-        // The median split's leaves hold 3 or 4 spheres, so the node count was
-        // only estimated: give back what the last doubling took too much.
-        bvh.nodes.shrink_to_fit();
-        bvh
-    }
-
-    /// Add the subtree of `items` (depth first) and return its node's index. Its
-    /// box is widened by `widen` and rounded outwards to float32.
-    fn split(&mut self, items: &mut [Item], widen: f64) -> usize {
-        let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-        let (mut low, mut high) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-        for item in items.iter() {
-            (min, max) = (min.min(item.min), max.max(item.max));
-            (low, high) = (low.min(item.centre), high.max(item.centre));
-        }
-        let at = self.nodes.len();
-        self.nodes.push(Node {
-            min: (min - widen).to_array().map(below).into(),
-            max: (max + widen).to_array().map(above).into(),
-            first: self.items.len() as u32,
-            count: items.len() as u32,
-        });
-        if items.len() <= LEAF {
-            self.items.extend(items.iter().map(|i| i.index));
-            let ball = |i: &Item| [i.centre.x, i.centre.y, i.centre.z, i.radius];
-            self.balls.extend(items.iter().map(ball));
-            return at;
-        }
-        let spread = high - low;
-        let axis = if spread.x >= spread.y && spread.x >= spread.z {
-            0
-        } else if spread.y >= spread.z {
-            1
-        } else {
-            2
-        };
-        let middle = items.len() / 2;
-        items.select_nth_unstable_by(middle, |a, b| {
-            a.centre[axis]
-                .total_cmp(&b.centre[axis])
-                .then(a.index.cmp(&b.index))
-        });
-        let (left, right) = items.split_at_mut(middle);
-        self.split(left, widen);
-        let second = self.split(right, widen);
-        self.nodes[at].first = second as u32;
-        self.nodes[at].count = 0;
-        at
     }
 
     /// Number of nodes.
@@ -390,6 +434,175 @@ impl Bvh {
     }
 }
 
+/// The box of some spheres and the box of their centres.
+#[derive(Clone, Copy)]
+struct Span {
+    bounds: Bounds,
+    centres: Bounds,
+}
+
+impl Span {
+    const EMPTY: Span = Span {
+        bounds: Bounds::EMPTY,
+        centres: Bounds::EMPTY,
+    };
+
+    #[inline]
+    fn add(&mut self, item: &Item) {
+        self.bounds.add(item.min, item.max);
+        let c = item.centre();
+        self.centres.add(c, c);
+    }
+
+    #[inline]
+    fn join(&mut self, other: &Span) {
+        self.bounds.join(&other.bounds);
+        self.centres.join(&other.centres);
+    }
+
+    /// The span of `items`.
+    fn of(items: &[Item]) -> Span {
+        let mut span = Span::EMPTY;
+        for i in items {
+            span.add(i);
+        }
+        span
+    }
+}
+
+/// The nodes of the subtree over `items` (of span `span`), the slice of the
+/// build's list that starts at `offset`, at `depth` in the tree: depth first,
+/// each node's first child right after it, its second child's index (`first`)
+/// counted from the subtree's root. The two children of a large subtree are
+/// built in parallel, each into a list of its own, and joined; a small one is
+/// grown into one list ([`grow`]).
+fn subtree(items: &mut [Item], span: Span, offset: usize, depth: usize, widen: f64) -> Vec<Node> {
+    if items.len() < PARALLEL_FROM {
+        let mut nodes = Vec::with_capacity(items.len());
+        grow(items, span, offset, depth, widen, &mut nodes);
+        return nodes;
+    }
+    let (middle, spans) = divide(items, &span, depth);
+    let (left, right) = items.split_at_mut(middle);
+    let (a, b) = rayon::join(
+        || subtree(left, spans[0], offset, depth + 1, widen),
+        || subtree(right, spans[1], offset + middle, depth + 1, widen),
+    );
+    let mut nodes = Vec::with_capacity(1 + a.len() + b.len());
+    nodes.push(span.bounds.node(widen, (1 + a.len()) as u32, 0));
+    for part in [a, b] {
+        let base = nodes.len() as u32;
+        nodes.extend(part.into_iter().map(|mut n| {
+            if n.count == 0 {
+                n.first += base;
+            }
+            n
+        }));
+    }
+    nodes
+}
+
+/// Add the subtree over `items` (of span `span`, the slice of the build's list
+/// from `offset`) to `nodes`, depth first.
+fn grow(
+    items: &mut [Item],
+    span: Span,
+    offset: usize,
+    depth: usize,
+    widen: f64,
+    nodes: &mut Vec<Node>,
+) {
+    if items.len() <= LEAF {
+        nodes.push(span.bounds.node(widen, offset as u32, items.len() as u32));
+        return;
+    }
+    let (middle, spans) = divide(items, &span, depth);
+    let at = nodes.len();
+    nodes.push(span.bounds.node(widen, 0, 0));
+    let (left, right) = items.split_at_mut(middle);
+    grow(left, spans[0], offset, depth + 1, widen, nodes);
+    nodes[at].first = nodes.len() as u32;
+    grow(right, spans[1], offset + middle, depth + 1, widen, nodes);
+}
+
+/// Split `items` (of span `span`) in two, in place: the spheres of the first
+/// child first. Returns how many those are (never 0 nor all) and the two
+/// children's spans.
+///
+/// The split is by the surface area heuristic over [`BINS`] bins of the box
+/// centres along the axis where they spread most: the boundary between two bins
+/// that minimises each side's box area times its number of spheres (the lowest
+/// such). From depth [`SAH_DEPTH`] on, or where every centre is the same, it is
+/// at the median along that axis instead.
+fn divide(items: &mut [Item], span: &Span, depth: usize) -> (usize, [Span; 2]) {
+    let spread = span.centres.max - span.centres.min;
+    let axis = if spread.x >= spread.y && spread.x >= spread.z {
+        0
+    } else if spread.y >= spread.z {
+        1
+    } else {
+        2
+    };
+    let low = span.centres.min[axis];
+    let scale = BINS as f32 / spread[axis];
+    if depth >= SAH_DEPTH || !(spread[axis] > 0.0 && scale.is_finite()) {
+        let middle = items.len() / 2;
+        items.select_nth_unstable_by(middle, |a, b| {
+            a.centre()[axis]
+                .total_cmp(&b.centre()[axis])
+                .then(a.index.cmp(&b.index))
+        });
+        let (left, right) = items.split_at(middle);
+        return (middle, [Span::of(left), Span::of(right)]);
+    }
+    let mut bins = [Span::EMPTY; BINS];
+    let mut counts = [0u32; BINS];
+    for i in items.iter() {
+        let k = bin_of(i.centre()[axis], low, scale);
+        counts[k] += 1;
+        bins[k].add(i);
+    }
+    // The area of the bins from k on, for each k.
+    let mut right_area = [0.0; BINS];
+    let mut right = Bounds::EMPTY;
+    for k in (1..BINS).rev() {
+        right.join(&bins[k].bounds);
+        right_area[k] = right.half_area();
+    }
+    let mut best = (f64::INFINITY, 0);
+    let mut left = Bounds::EMPTY;
+    let mut on_left = 0usize;
+    for k in 0..BINS - 1 {
+        left.join(&bins[k].bounds);
+        on_left += counts[k] as usize;
+        let on_right = items.len() - on_left;
+        if on_left == 0 || on_right == 0 {
+            continue;
+        }
+        let cost = left.half_area() * on_left as f64 + right_area[k + 1] * on_right as f64;
+        if cost < best.0 {
+            best = (cost, k);
+        }
+    }
+    // The lowest and the highest centre fall in the first and the last bin, so
+    // some boundary has spheres on both sides.
+    let bin = best.1;
+    let mut spans = [Span::EMPTY; 2];
+    for (k, b) in bins.iter().enumerate() {
+        spans[usize::from(k > bin)].join(b);
+    }
+    let (mut i, mut j) = (0, items.len());
+    while i < j {
+        if bin_of(items[i].centre()[axis], low, scale) <= bin {
+            i += 1;
+        } else {
+            j -= 1;
+            items.swap(i, j);
+        }
+    }
+    (i, spans)
+}
+
 /// The largest float32 not above `x`.
 pub(crate) fn below(x: f64) -> f32 {
     let r = x as f32;
@@ -437,9 +650,29 @@ mod tests {
 
     use super::test_ball as ball;
 
-    #[test]
-    fn every_sphere_sits_in_one_leaf_and_the_depth_fits_the_stack() {
-        let objects: Vec<Object> = (0..1000)
+    /// The depth of the subtree at `node`, checking on the way that each leaf
+    /// holds 1 to `LEAF` spheres and each node's box holds its children's.
+    fn depth(bvh: &Bvh, node: usize) -> usize {
+        let n = bvh.nodes[node];
+        let inside = |m: &Node| n.min.cmple(m.min).all() && m.max.cmple(n.max).all();
+        if n.count > 0 {
+            assert!(n.count as usize <= LEAF);
+            for b in &bvh.balls[n.first as usize..(n.first + n.count) as usize] {
+                let (c, r) = (Vec3::new(b[0], b[1], b[2]), b[3]);
+                assert!(
+                    n.min.as_dvec3().cmple(c - r).all() && (c + r).cmple(n.max.as_dvec3()).all()
+                );
+            }
+            1
+        } else {
+            let (a, b) = (node + 1, n.first as usize);
+            assert!(inside(&bvh.nodes[a]) && inside(&bvh.nodes[b]));
+            1 + depth(bvh, a).max(depth(bvh, b))
+        }
+    }
+
+    fn grid(count: i32) -> Vec<Object> {
+        (0..count)
             .map(|i| {
                 ball(
                     f64::from(i % 10),
@@ -448,21 +681,74 @@ mod tests {
                     0.3,
                 )
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn every_sphere_sits_in_one_leaf_and_the_depth_fits_the_stack() {
+        let objects = grid(1000);
         let bvh = Bvh::build(&objects);
         let mut seen = bvh.items.clone();
         seen.sort_unstable();
         assert_eq!(seen, (0..1000).collect::<Vec<u32>>());
-        // Depth of the tree: at most log2(1000 / LEAF) + 1 levels.
-        fn depth(bvh: &Bvh, node: usize) -> usize {
-            let n = bvh.nodes[node];
-            if n.count > 0 {
-                1
-            } else {
-                1 + depth(bvh, node + 1).max(depth(bvh, n.first as usize))
-            }
+        // The surface area heuristic keeps an even grid about balanced:
+        // log2(1000 / LEAF) + 1 is 9 levels.
+        assert!(depth(&bvh, 0) <= 12, "{}", depth(&bvh, 0));
+        // Leaves' spheres in `balls` are theirs.
+        for (k, &i) in bvh.items.iter().enumerate() {
+            let Shape::Sphere(s) = objects[i as usize].shape else {
+                unreachable!()
+            };
+            assert_eq!(bvh.balls[k], [s.center.x, s.center.y, s.center.z, s.radius]);
         }
-        assert!(depth(&bvh, 0) <= 10, "{}", depth(&bvh, 0));
+    }
+
+    #[test]
+    fn uneven_scenes_keep_the_depth_within_the_stack() {
+        // Spheres each twice as far out as the one before: the heuristic cuts off
+        // one at a time, until the median takes over at SAH_DEPTH.
+        let chain: Vec<Object> = (0..200)
+            .map(|i| ball(1.5f64.powi(i), 0.0, 0.0, 0.1))
+            .collect();
+        // Many spheres at one centre: no split of the centres but the median's.
+        let same: Vec<Object> = (0..5000).map(|_| ball(1.0, 2.0, 3.0, 0.5)).collect();
+        for objects in [chain, same] {
+            let bvh = Bvh::build(&objects);
+            let d = depth(&bvh, 0);
+            assert!(d < 64, "{d}");
+            assert_eq!(bvh.items.len(), objects.len());
+        }
+    }
+
+    #[test]
+    fn the_tree_is_the_same_on_one_thread_and_on_many() {
+        // Large enough for the parallel build (PARALLEL_FROM), on pools of 1 and 3.
+        let objects = crate::tools::generate::scene(3 * PARALLEL_FROM, 5).objects;
+        let build = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| Bvh::build::<f64>(&objects))
+        };
+        let (one, three) = (build(1), build(3));
+        depth(&one, 0);
+        let bits = |b: &Bvh| {
+            b.nodes
+                .iter()
+                .map(|n| {
+                    (
+                        n.min.to_array().map(f32::to_bits),
+                        n.max.to_array().map(f32::to_bits),
+                        n.first,
+                        n.count,
+                    )
+                })
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bits(&one), bits(&three));
+        assert_eq!(one.items, three.items);
+        assert_eq!(one.loose, three.loose);
     }
 
     #[test]

@@ -13,11 +13,15 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use crate::accel::{Accel, BVH_FROM};
 use crate::aov::{Frame, Packets, Rays};
+use crate::bvh::Bvh;
 use crate::engine::render_into;
 use crate::error::Error;
+use crate::real::Precision;
 use crate::render::Settings;
-use crate::scene::Scene;
+use crate::scene::{Role, Scene};
+use crate::sphere::Method;
 use crate::stages::Engine;
 use crate::tools::yardstick::Yardstick;
 
@@ -68,6 +72,12 @@ pub struct Report {
     pub other_median_s: f64,
     /// `yardstick_median_s / other_median_s`.
     pub other_yardstick_ratio: Option<f64>,
+    /// Median seconds to build the BVH over the scene's spheres with `threads`
+    /// threads, timed in turn with the renders (absent when the render uses no
+    /// BVH). The render's own build is part of `median_s`.
+    pub bvh_build_s: Option<f64>,
+    /// Nodes of that BVH.
+    pub bvh_nodes: Option<usize>,
     /// Peak resident memory of the process so far, in bytes (Linux only).
     pub peak_memory_bytes: Option<u64>,
     /// The build of the fast engine's packet loop in this run (whichever of the two
@@ -115,6 +125,13 @@ pub fn bench(
         },
         ..*settings
     };
+    // The tree the render builds, timed on its own too (from the objects in the
+    // render's precision).
+    let uses = uses_bvh(scene, settings);
+    let tree = uses.then(|| scene.objects_in_play::<f64>(settings.stages));
+    let tree32 = (uses && settings.precision == Precision::F32)
+        .then(|| scene.objects_in_play::<f32>(settings.stages));
+    let nodes = Cell::new(0);
     let mut frame = Frame::blank(scene.camera(), settings.precision);
     // The other engine and the one-thread run take turns with one more frame (the
     // jobs run one after another); what the fast engine's packets were is noted
@@ -146,6 +163,15 @@ pub fn bench(
             yardstick_total.set(many.install(|| y.render_into(&mut image, &mut yardstick_rays)))
         }));
     }
+    if let Some(objects) = &tree {
+        jobs.push(Box::new(|| {
+            let count = many.install(|| match &tree32 {
+                Some(objects) => Bvh::build(objects).node_count(),
+                None => Bvh::build(objects).node_count(),
+            });
+            nodes.set(count);
+        }));
+    }
     let mut seconds = vec![Vec::with_capacity(options.runs); jobs.len()];
     for run in 0..=options.runs {
         // Each run starts with the next job, so none is always first or last.
@@ -172,6 +198,7 @@ pub fn bench(
     let other_median_s = medians.next().expect("both engines are always timed");
     let one_thread_median_s = (options.threads > 1).then(|| medians.next()).flatten();
     let yardstick_median_s = yardstick.is_some().then(|| medians.next()).flatten();
+    let bvh_build_s = tree.is_some().then(|| medians.next()).flatten();
     let pixels = f64::from(scene.width) * f64::from(scene.height);
     Ok(Report {
         width: scene.width,
@@ -195,9 +222,27 @@ pub fn bench(
         other_engine: other.engine.name(),
         other_median_s,
         other_yardstick_ratio: yardstick_median_s.map(|t| t / other_median_s),
+        bvh_build_s,
+        bvh_nodes: bvh_build_s.map(|_| nodes.get()),
         peak_memory_bytes: peak_memory_bytes(),
         packets: packets.name(),
     })
+}
+
+/// Does a render of `scene` under `settings` build a BVH? (As `Tracer::new`
+/// decides.)
+fn uses_bvh(scene: &Scene, settings: &Settings) -> bool {
+    let spheres = scene
+        .objects
+        .iter()
+        .filter(|o| o.role == Role::Sphere)
+        .count();
+    match settings.accel {
+        _ if settings.method == Method::Naive => false,
+        Accel::Off => false,
+        Accel::Auto => spheres >= BVH_FROM,
+        Accel::Bvh => true,
+    }
 }
 
 /// The median of some times (the mean of the middle two for an even count).
@@ -291,6 +336,12 @@ impl Report {
             _ => {
                 line("  yardstick   not run (a scene with a true plane, or --no-yardstick)".into())
             }
+        }
+        if let (Some(t), Some(n)) = (self.bvh_build_s, self.bvh_nodes) {
+            line(format!(
+                "  BVH build   {t:>9.4} s ({n} nodes, {} threads; part of each frame's time)",
+                self.threads
+            ));
         }
         if let Some(bytes) = self.peak_memory_bytes {
             line(format!("  peak memory {:>9.1} MB", bytes as f64 / 1e6));

@@ -14,7 +14,8 @@
 //!
 //! **Scale.** Generated scenes of N spheres ([`crate::tools::generate`]) at the chart's
 //! size, rendered with `--accel auto` and with the plain loop (`--accel off`, up to
-//! the count where it becomes too slow to wait for).
+//! the count where it becomes too slow to wait for), and with `--embree PATH` by
+//! the Embree program of `benches/embree` on the same scenes, beside them.
 
 use std::path::Path;
 use std::time::Instant;
@@ -268,30 +269,52 @@ fn csv_text<const N: usize>(header: &[&str; N], rows: impl Iterator<Item = [Stri
     String::from_utf8(bytes).expect("CSV of strings is UTF-8")
 }
 
+/// Who drew a point of the scale sweep.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Series {
+    /// raystep's fast engine with this `--accel`.
+    Raystep(Accel),
+    /// The Embree program of `benches/embree` on the same scene.
+    Embree,
+}
+
+impl std::fmt::Display for Series {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Series::Raystep(accel) => accel.fmt(f),
+            Series::Embree => f.write_str("embree"),
+        }
+    }
+}
+
 /// One measurement of the scale sweep.
 #[derive(Clone, Debug)]
 pub struct ScalePoint {
     /// Spheres in the scene.
     pub count: usize,
-    /// How the nearest hit was searched for.
-    pub accel: Accel,
-    /// Median seconds per frame (render only, BVH build included).
+    /// How the nearest hit was searched for (or Embree).
+    pub series: Series,
+    /// Median seconds per frame (render only; raystep's includes its BVH build,
+    /// Embree's does not).
     pub median_s: f64,
     /// Seconds to build the BVH alone (0 without one).
     pub build_s: f64,
-    /// Bytes of the BVH.
+    /// Bytes of the BVH (raystep's; 0 without one, and for Embree).
     pub bvh_bytes: usize,
 }
 
 /// Render generated scenes of each count in `counts` at `width × height`, with
-/// `--accel auto` and, up to `plain_up_to` spheres, `--accel off`.
+/// `--accel auto` and, up to `plain_up_to` spheres, `--accel off`; and, given
+/// the path of the Embree program (`benches/embree/run.sh build`), with it too,
+/// right after raystep's renders of the same scene, on as many threads.
 pub fn scale(
     counts: &[usize],
     plain_up_to: usize,
     (width, height): (u32, u32),
     runs: usize,
+    embree: Option<&Path>,
     progress: &dyn Fn(u64),
-) -> Vec<ScalePoint> {
+) -> Result<Vec<ScalePoint>, Error> {
     let mut points = Vec::new();
     for &count in counts {
         let mut scene = crate::tools::generate::scene(count, 1);
@@ -322,14 +345,80 @@ pub fn scale(
             let uses_bvh = accel == Accel::Auto && count >= crate::accel::BVH_FROM;
             points.push(ScalePoint {
                 count,
-                accel,
+                series: Series::Raystep(accel),
                 median_s: median(times),
                 build_s: if uses_bvh { build_s } else { 0.0 },
                 bvh_bytes: if uses_bvh { bvh.bytes() } else { 0 },
             });
         }
+        if let Some(program) = embree {
+            let (median_s, build_s) = run_embree(program, count, (width, height), runs)?;
+            points.push(ScalePoint {
+                count,
+                series: Series::Embree,
+                median_s,
+                build_s,
+                bvh_bytes: 0,
+            });
+            progress(1);
+        }
     }
-    points
+    Ok(points)
+}
+
+/// Run the Embree program on the generated scene of `count` spheres (seed 1,
+/// written to its standard input) at `width × height`, `runs` timed runs after
+/// a warm-up, on rayon's number of threads: its median seconds per frame and its
+/// build's seconds, from the CSV row it prints.
+fn run_embree(
+    program: &Path,
+    count: usize,
+    (width, height): (u32, u32),
+    runs: usize,
+) -> Result<(f64, f64), Error> {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let fail = |message: String| Error::Output {
+        path: program.to_path_buf(),
+        message,
+    };
+    let mut child = Command::new(program)
+        .args([
+            "--width",
+            &width.to_string(),
+            "--height",
+            &height.to_string(),
+        ])
+        .args(["--runs", &runs.to_string()])
+        .args(["--threads", &rayon::current_num_threads().to_string(), "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(|e| fail(format!("cannot run the Embree program: {e}")))?;
+    let text = crate::tools::generate::spheres_toml(count, 1);
+    let mut stdin = child.stdin.take().expect("stdin is piped");
+    let writer = std::thread::spawn(move || stdin.write_all(text.as_bytes()));
+    let output = child
+        .wait_with_output()
+        .map_err(|e| fail(format!("the Embree program failed: {e}")))?;
+    let _ = writer.join();
+    if !output.status.success() {
+        return Err(fail(format!(
+            "the Embree program failed: {}",
+            output.status
+        )));
+    }
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let mut lines = stdout.lines();
+    let (header, row) = (lines.next().unwrap_or(""), lines.next().unwrap_or(""));
+    let field = |name: &str| -> Option<f64> {
+        let k = header.split(',').position(|h| h == name)?;
+        row.split(',').nth(k)?.parse().ok()
+    };
+    match (field("median_ms"), field("build_ms")) {
+        (Some(median), Some(build)) => Ok((median / 1e3, build / 1e3)),
+        _ => Err(fail(format!("unexpected output: {stdout}"))),
+    }
 }
 
 /// The scale points as CSV.
@@ -339,7 +428,7 @@ pub fn scale_csv(points: &[ScalePoint]) -> String {
         points.iter().map(|p| {
             [
                 p.count.to_string(),
-                p.accel.to_string(),
+                p.series.to_string(),
                 format!("{:.3}", p.median_s * 1e3),
                 format!("{:.3}", p.build_s * 1e3),
                 p.bvh_bytes.to_string(),
@@ -601,20 +690,31 @@ fn draw_scale<DB: DrawingBackend>(
         ),
         0,
     )?;
-    let auto = format!("--accel auto (BVH from {} spheres)", crate::accel::BVH_FROM);
-    for (accel, colour, name) in [
-        (Accel::Auto, BLUE, auto.as_str()),
+    let auto = format!(
+        "raystep --accel auto (BVH from {} spheres)",
+        crate::accel::BVH_FROM
+    );
+    for (series, colour, name) in [
+        (Series::Raystep(Accel::Auto), BLUE, auto.as_str()),
         (
-            Accel::Off,
+            Series::Raystep(Accel::Off),
             RGBColor(200, 30, 30),
-            "--accel off (plain loop)",
+            "raystep --accel off (plain loop)",
+        ),
+        (
+            Series::Embree,
+            RGBColor(20, 140, 60),
+            "Embree 3, user-geometry spheres, 8-ray packets (build not counted)",
         ),
     ] {
         let series: Vec<(f64, f64)> = points
             .iter()
-            .filter(|p| p.accel == accel)
+            .filter(|p| p.series == series)
             .map(|p| (p.count as f64, p.median_s * 1e3))
             .collect();
+        if series.is_empty() {
+            continue;
+        }
         chart
             .draw_series(LineSeries::new(series.clone(), colour.stroke_width(2)))
             .map_err(e)?

@@ -236,6 +236,10 @@ pub struct ChartArgs {
     /// With --scale, the largest count (powers of ten and their triples up to it).
     #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..=10_000_000))]
     pub max_count: u64,
+    /// With --scale, also time the Embree program at PATH on each scene (built by
+    /// `benches/embree/run.sh build`), drawn beside raystep's points.
+    #[arg(long, value_name = "PATH", requires = "scale")]
+    pub embree: Option<PathBuf>,
     /// Where the CSV and the charts go.
     #[arg(long, short = 'o', visible_alias = "output", default_value = "out")]
     pub out: PathBuf,
@@ -946,7 +950,12 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
         let renders: u64 = counts
             .iter()
             .map(|&n| if n <= plain_up_to { 2 } else { 1 } * (args.runs as u64 + 1))
-            .sum();
+            .sum::<u64>()
+            + if args.embree.is_some() {
+                counts.len() as u64
+            } else {
+                0
+            };
         status!(
             "time against spheres at {} × {}: {} counts",
             size.0,
@@ -954,7 +963,9 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
             counts.len()
         );
         let bar = counted_bar(renders, "scale", "renders");
-        let points = crate::tools::chart::scale(&counts, plain_up_to, size, runs, &|n| bar.inc(n));
+        let embree = args.embree.as_deref();
+        let points =
+            crate::tools::chart::scale(&counts, plain_up_to, size, runs, embree, &|n| bar.inc(n))?;
         bar.finish_and_clear();
         crate::error::check_interrupt()?;
         let csv = crate::tools::chart::scale_csv(&points);
