@@ -151,8 +151,16 @@ pub fn step_out<V: Vec3Num>(on_surface: V, normal: V, anchor: V, u: V::Num) -> V
     let from_anchor = (on_surface - anchor).length();
     let bound = u
         * (V::Num::of(ANCHOR_UNITS) * from_anchor + V::Num::of(ORIGIN_UNITS) * on_surface.length());
+    // A point so far out that its length overflows (a plane met at t ~ 1e300)
+    // would step by ∞ and turn every coordinate it touches into NaN: at most
+    // `STEP_CAP`, which no scene within the limits comes near.
+    let bound = -(-bound).max(-V::Num::of(STEP_CAP));
     on_surface + normal * bound
 }
+
+/// The largest `auto` step: finite in float32 too, and beyond any step a scene
+/// inside the limits (coordinates up to 1e15) can need.
+pub const STEP_CAP: f64 = 1e38;
 // ANCHOR_END: step_off
 
 /// The `scene` step: out along the unit `normal` by [`SCENE_FACTOR`] unit
