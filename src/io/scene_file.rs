@@ -14,6 +14,7 @@ use crate::error::Error;
 use crate::plane::Plane;
 use crate::real::Precision;
 use crate::scene::{Light, Material, Object, Role, Scene, Shape};
+use crate::shade::shadow::{auto_step, pass_over};
 use crate::sphere::Sphere;
 use crate::Vec3;
 
@@ -627,17 +628,7 @@ impl SceneFile {
         // Near the screen's plane (but not on it) rays to the screen are too short
         // to have a direction in floating point.
         let edges = screen.unwrap_or(Screen::for_image(width, height));
-        let size = [
-            camera.x,
-            camera.y,
-            edges.left,
-            edges.right,
-            edges.top,
-            edges.bottom,
-        ]
-        .map(f64::abs)
-        .into_iter()
-        .fold(0.0, f64::max);
+        let size = view_size(camera, &edges);
         let nearest = least_length(size, MIN_RADIUS_RATIO_F64);
         if camera.z.abs() < nearest {
             return Err(format!(
@@ -838,6 +829,23 @@ fn colour(value: Option<Triple>, default: Vec3, key: &str) -> Result<Vec3, Strin
     Ok(c)
 }
 
+/// The size of the numbers a primary ray is made from: the largest of the eye's
+/// x and y and the screen's edges, in absolute value (the eye's z is what is
+/// checked against it).
+fn view_size(camera: Vec3, screen: &Screen) -> f64 {
+    [
+        camera.x,
+        camera.y,
+        screen.left,
+        screen.right,
+        screen.top,
+        screen.bottom,
+    ]
+    .map(f64::abs)
+    .into_iter()
+    .fold(0.0, f64::max)
+}
+
 /// The least length (a radius, the camera's distance from the screen) that a
 /// precision resolves among coordinates up to `size`: `ratio` of it
 /// ([`MIN_RADIUS_RATIO`] in float32, [`MIN_RADIUS_RATIO_F64`] in float64), and at
@@ -932,18 +940,7 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
         return Ok(Vec::new());
     }
     let to_f64 = "; float64 (the default precision, --precision f64) renders it";
-    let edges = scene.camera().screen;
-    let size = [
-        scene.camera.x,
-        scene.camera.y,
-        edges.left,
-        edges.right,
-        edges.top,
-        edges.bottom,
-    ]
-    .map(f64::abs)
-    .into_iter()
-    .fold(0.0, f64::max);
+    let size = view_size(scene.camera, &scene.camera().screen);
     if scene.camera.z.abs() < least_length(size, MIN_RADIUS_RATIO) {
         return Err(format!(
             "camera.position: z = {} puts the eye too near the screen for float32 \
@@ -961,14 +958,12 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
             Shape::Sphere(s) => {
                 placed(s, &at, scene.camera, light, MIN_RADIUS_RATIO)
                     .map_err(|e| format!("{e}{to_f64}"))?;
-                let band = f32_terminator(s);
+                // At the sphere's point farthest from the origin, where the step
+                // is longest.
+                let far = s.center + s.center.normalize_or(Vec3::X) * s.radius;
+                let band = pass_over(F32_U, s.radius, far);
                 if band > F32_TERMINATOR_WARNING {
-                    let far = s.center + s.center.normalize_or(Vec3::X) * s.radius;
-                    let step = crate::tools::accuracy::auto_step(
-                        f64::from(f32::EPSILON) / 2.0,
-                        s.radius,
-                        far,
-                    );
+                    let step = auto_step(F32_U, s.radius, far);
                     warnings.push(format!(
                         "{at}: its centre is {:.1e} radii from the origin; float32 places its \
                          points to within {step:.1e} ({:.2} of its radius), so shadow rays \
@@ -999,12 +994,8 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
     Ok(warnings)
 }
 
-/// The terminator band float32 leaves on sphere `s` at its point farthest from
-/// the origin (see [`crate::tools::accuracy::terminator_band`]).
-fn f32_terminator(s: &Sphere) -> f64 {
-    let far = s.center + s.center.normalize_or(Vec3::X) * s.radius;
-    crate::tools::accuracy::terminator_band(f64::from(f32::EPSILON) / 2.0, s.radius, far)
-}
+/// float32's unit roundoff.
+const F32_U: f64 = f32::EPSILON as f64 / 2.0;
 
 /// An object as messages name it.
 fn describe(object: &Object) -> String {

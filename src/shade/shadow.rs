@@ -157,11 +157,27 @@ pub fn step_out<V: Vec3Num>(on_surface: V, normal: V, anchor: V, u: V::Num) -> V
     let bound = -(-bound).max(-V::Num::of(STEP_CAP));
     on_surface + normal * bound
 }
+// ANCHOR_END: step_off
 
 /// The largest `auto` step: finite in float32 too, and beyond any step a scene
 /// inside the limits (coordinates up to 1e15) can need.
 pub const STEP_CAP: f64 = 1e38;
-// ANCHOR_END: step_off
+
+/// The length of the `auto` step at a point `on_surface` of a surface of radius
+/// `radius` (for a plane: the distance from its anchor), in unit roundoffs `u`:
+/// [`step_out`]'s bound, as one number (for the accuracy judge and the float32
+/// warnings).
+pub fn auto_step(u: f64, radius: f64, on_surface: crate::Vec3) -> f64 {
+    u * (ANCHOR_UNITS * radius + ORIGIN_UNITS * on_surface.length())
+}
+
+/// How far round the terminator a shadow ray that starts the `auto` step `h` above
+/// a sphere of radius `radius` passes over it: it enters the sphere at `|L·N| = s`
+/// only if `(r + h)·√(1 − s²) ≤ r`, so for `s` below about `√(2h/r)` it clears it.
+/// In float32 that is at least `√(20u)` = 1.1e-3.
+pub fn pass_over(u: f64, radius: f64, on_surface: crate::Vec3) -> f64 {
+    (2.0 * auto_step(u, radius, on_surface) / radius).sqrt()
+}
 
 /// The `scene` step: out along the unit `normal` by [`SCENE_FACTOR`] unit
 /// roundoffs `u` of the larger of the surface's `magnitude` and the point's

@@ -14,7 +14,7 @@ use crate::ray::Ray;
 use crate::real::{Precision, Real, Vector};
 use crate::render::{Settings, Tracer};
 use crate::scene::{Object, Scene, Shape};
-use crate::shade::shadow::{step_off, Offset};
+use crate::shade::shadow::{auto_step, pass_over, step_off, Offset};
 use crate::sphere::{Method, Sphere};
 use crate::stages::Stages;
 use crate::Vec3;
@@ -137,24 +137,14 @@ pub fn silhouette_band(u: f64, origin: Vec3, s: &Sphere) -> f64 {
     relative.max(SILHOUETTE_UNITS * u * sizes)
 }
 
-/// The `auto` step at a point `on_surface` of a surface of radius `radius`
-/// (for a plane: the distance from its anchor), in unit roundoffs `u`: the
-/// formula of [`crate::shade::shadow::step_out`].
-pub fn auto_step(u: f64, radius: f64, on_surface: Vec3) -> f64 {
-    use crate::shade::shadow::{ANCHOR_UNITS, ORIGIN_UNITS};
-    u * (ANCHOR_UNITS * radius + ORIGIN_UNITS * on_surface.length())
-}
-
 /// The terminator band at a point `on_surface` of a sphere of radius `radius`,
-/// for a precision of unit roundoff `u`: a shadow ray that starts a height `h`
-/// above a sphere and enters it at `|L·N| = s` passes over it when
-/// `(r + h)·√(1 − s²) > r`, that is for `s` below about `√(2h/r)`. With `h` the
-/// `auto` step, which no offset that keeps origins outside can undercut by more
-/// than a small factor, the band is the larger of [`TERMINATOR_BAND`] and that.
-/// In float64 it is [`TERMINATOR_BAND`] for any sphere within 1e9 radii of the
-/// origin; in float32 `√(2h/r)` is at least `√(20u)` = 1.1e-3.
+/// for a precision of unit roundoff `u`: the larger of [`TERMINATOR_BAND`] and
+/// the band in which a shadow ray started the `auto` step `h` out passes over
+/// its own sphere ([`pass_over`], about `√(2h/r)`), which no offset that keeps
+/// origins outside can undercut by more than a small factor. In float64 it is
+/// [`TERMINATOR_BAND`] for any sphere within 1e9 radii of the origin.
 pub fn terminator_band(u: f64, radius: f64, on_surface: Vec3) -> f64 {
-    TERMINATOR_BAND.max((2.0 * auto_step(u, radius, on_surface) / radius).sqrt())
+    TERMINATOR_BAND.max(pass_over(u, radius, on_surface))
 }
 
 /// What one configuration gets wrong on one scene.
