@@ -192,3 +192,24 @@ pub fn plane_recast<T: raystep::real::Real>(
     let meets = pl.intersect(&ray_from(through)).is_some();
     Some((misses, meets))
 }
+
+/// Check that a browser's screenshot `bytes` (read from `path`) is a PNG of the
+/// window's `size` and not one flat colour: at least `least_colours` colours.
+pub fn check_screenshot(
+    bytes: &[u8],
+    path: &std::path::Path,
+    size: (u32, u32),
+    least_colours: usize,
+) {
+    let picture = image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgb8();
+    assert_eq!(picture.dimensions(), size, "{}", path.display());
+    let colours: std::collections::HashSet<[u8; 3]> = picture.pixels().map(|p| p.0).collect();
+    assert!(
+        colours.len() >= least_colours,
+        "{}: {} colours",
+        path.display(),
+        colours.len()
+    );
+}
