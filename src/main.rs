@@ -5,7 +5,8 @@
 use std::process::ExitCode;
 
 use clap::Parser;
-use raystep::tools::cli::{execute, Cli};
+use raystep::tools::args::Cli;
+use raystep::tools::cli::execute;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();

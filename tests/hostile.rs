@@ -507,7 +507,7 @@ fn help_states_every_limit_with_the_numbers_the_code_uses() {
     let help = raystep(Path::new("."), &["--help"]);
     let help = String::from_utf8_lossy(&help.stdout);
     assert!(
-        help.contains(raystep::tools::cli::LIMITS),
+        help.contains(raystep::tools::args::LIMITS),
         "--help ends with the limits"
     );
     let (w, h) = (7680u64, 4320u64);
@@ -530,7 +530,7 @@ fn help_states_every_limit_with_the_numbers_the_code_uses() {
         ),
     ] {
         assert!(
-            raystep::tools::cli::LIMITS.contains(&stated),
+            raystep::tools::args::LIMITS.contains(&stated),
             "{stated:?} in the limits"
         );
     }

@@ -25,7 +25,7 @@ use crate::io::scene_file::{self, SizeOverride};
 use crate::render::Settings;
 use crate::scene::{Role, Scene, Shape};
 use crate::stages::Stages;
-use crate::tools::cli::{check_pixel, Cli, Command, FrameArgs};
+use crate::tools::args::{check_pixel, Cli, Command, FrameArgs};
 
 /// The longest query string taken, in bytes (a page's query is a few hundred).
 pub const MAX_QUERY_BYTES: usize = 4096;
@@ -528,7 +528,7 @@ impl Studio {
         let (x, y) = args.pixel;
         check_pixel(&scene, x, y)?;
         let story = crate::tools::explain::explain(&scene, &settings, x, y);
-        Ok(crate::tools::cli::json_text(&story, true) + "\n")
+        Ok(crate::tools::json::json_text(&story, true) + "\n")
     }
 
     /// `GET /api/scene`: the version, the error of the latest reload (or null),

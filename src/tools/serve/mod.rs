@@ -25,7 +25,6 @@ pub mod api;
 use std::collections::{HashMap, VecDeque};
 use std::io::Write;
 use std::net::SocketAddr;
-use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
@@ -34,22 +33,8 @@ use tiny_http::{Header, Method, Request, Response, Server};
 
 use crate::error::Error;
 use crate::io::scene_file::MAX_PIXELS;
+use crate::tools::args::ServeArgs;
 use api::{Refusal, Studio};
-
-/// Arguments of `raystep serve`.
-#[derive(clap::Args, Debug)]
-pub struct ServeArgs {
-    /// Scene file (TOML) to serve; it is watched, and saving it re-renders the
-    /// page. Default: the built-in figure-1 scene (scenes/seed.toml).
-    pub scene: Option<PathBuf>,
-    /// The port to listen on, on 127.0.0.1 only (0: any free port; the address
-    /// printed says which).
-    #[arg(long, default_value_t = 8123)]
-    pub port: u16,
-    /// Open the page in the default browser once the server listens.
-    #[arg(long)]
-    pub open: bool,
-}
 
 /// Renders at once; more wait in line.
 pub const RENDERS_AT_ONCE: usize = 2;
@@ -530,7 +515,7 @@ fn diff(shared: &Shared, request: Request, query: &str) {
             let mut figures = api::diff_json(&a, &b);
             figures["a_version"] = jobs.a.version.into();
             figures["b_version"] = jobs.b.version.into();
-            let body = crate::tools::cli::json_text(&figures, true) + "\n";
+            let body = crate::tools::json::json_text(&figures, true) + "\n";
             let extra = [("X-Raystep-Renders", renders.to_string())];
             send(request, 200, JSON, body.into_bytes(), &extra)
         }
