@@ -89,7 +89,7 @@ impl std::fmt::Display for Offset {
 /// The hit point moved a little along the surface normal. A ray cast from the
 /// exact hit point could find the same surface again at a tiny distance, because
 /// the computed point lies a rounding error inside or outside it ("shadow acne").
-#[inline]
+#[inline(always)]
 pub fn step_off<T: Real>(
     point: T::Vec3,
     normal: T::Vec3,
