@@ -276,12 +276,12 @@ impl Report {
             out.push('\n');
         };
         line(format!(
-            "{} × {}, {} thread{}, median of {} runs",
+            "{} × {}, {}, median of {} run{}",
             self.width,
             self.height,
-            self.threads,
-            if self.threads == 1 { "" } else { "s" },
-            self.runs
+            count_threads(self.threads),
+            self.runs,
+            if self.runs == 1 { "" } else { "s" }
         ));
         line(format!(
             "  {:<11} {:>9.4} s per frame   {:>7.1} Mpixel/s   {:>7.1} Mray/s",
@@ -321,10 +321,10 @@ impl Report {
             (Some(t), Some(r)) => {
                 line(format!(
                     "  yardstick   {t:>9.4} s per frame   {:>7.1} Mpixel/s   {:>7.1} Mray/s   \
-                     (the tutorial's program ported plainly, {} threads)",
+                     (the tutorial's program ported plainly, {})",
                     f64::from(self.width) * f64::from(self.height) / t / 1e6,
                     self.yardstick_rays_per_s.unwrap_or(f64::NAN) / 1e6,
-                    self.threads
+                    count_threads(self.threads)
                 ));
                 let other = self.other_yardstick_ratio.unwrap_or(f64::NAN);
                 line(format!(
@@ -339,8 +339,8 @@ impl Report {
         }
         if let (Some(t), Some(n)) = (self.bvh_build_s, self.bvh_nodes) {
             line(format!(
-                "  BVH build   {t:>9.4} s ({n} nodes, {} threads; part of each frame's time)",
-                self.threads
+                "  BVH build   {t:>9.4} s ({n} nodes, {}; part of each frame's time)",
+                count_threads(self.threads)
             ));
         }
         if let Some(bytes) = self.peak_memory_bytes {
@@ -348,6 +348,11 @@ impl Report {
         }
         out
     }
+}
+
+/// "1 thread", "2 threads".
+fn count_threads(n: usize) -> String {
+    format!("{n} thread{}", if n == 1 { "" } else { "s" })
 }
 
 #[cfg(test)]
