@@ -616,6 +616,16 @@ fn render(shared: &Shared, request: Request, query: &str) {
             "X-Raystep-Size",
             format!("{}x{}", job.scene.width, job.scene.height),
         ),
+        // The screen and the eye this render looked through, for the page's
+        // drags (each number as Rust prints it: read back, the same f64).
+        ("X-Raystep-Screen", {
+            let s = job.scene.camera().screen;
+            format!("{},{},{},{}", s.left, s.right, s.top, s.bottom)
+        }),
+        ("X-Raystep-Camera", {
+            let [x, y, z] = job.scene.camera.to_array();
+            format!("{x},{y},{z}")
+        }),
     ];
     send(request, 200, "image/png", done.png, &extra);
 }
