@@ -30,6 +30,11 @@ impl Server {
 
     /// [`Server::start`] in the folder `dir` (a relative `scene` is in it).
     fn start_in(dir: Option<&Path>, scene: Option<&Path>) -> Server {
+        Server::start_with(dir, scene, Stdio::null())
+    }
+
+    /// [`Server::start_in`], its standard error to `stderr`.
+    fn start_with(dir: Option<&Path>, scene: Option<&Path>, stderr: Stdio) -> Server {
         let mut command = Command::new(env!("CARGO_BIN_EXE_raystep"));
         if let Some(dir) = dir {
             command.current_dir(dir);
@@ -42,7 +47,7 @@ impl Server {
             .args(["--port", "0"])
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
-            .stderr(Stdio::null())
+            .stderr(stderr)
             .spawn()
             .unwrap();
         let stdout = child.stdout.take().unwrap();
@@ -1006,7 +1011,7 @@ fn load_of_1000_requests_from_50_clients_is_answered_and_the_server_stays_up() {
                     };
                     let start = Instant::now();
                     let reply = exchange(port, &request);
-                    latencies.push(start.elapsed());
+                    latencies.push((start.elapsed(), reply.status));
                     assert!(
                         expected.contains(&reply.status),
                         "request {n}: {} for {request:?}",
@@ -1017,20 +1022,30 @@ fn load_of_1000_requests_from_50_clients_is_answered_and_the_server_stays_up() {
             })
         })
         .collect();
-    let mut latencies = Vec::new();
+    let mut latencies: Vec<(Duration, u16)> = Vec::new();
     for thread in threads {
         latencies.extend(thread.join().expect("every request is answered"));
     }
     let seconds = started.elapsed().as_secs_f64();
     assert_eq!(latencies.len(), CLIENTS * EACH);
+    let mut statuses = std::collections::BTreeMap::new();
+    for (_, status) in &latencies {
+        *statuses.entry(*status).or_insert(0) += 1;
+    }
+    // 600 answered, 100 bad options and 100 not HTTP refused with 400, 100
+    // foreign hosts with 421, 100 paths out of the page with 404.
+    assert_eq!(
+        statuses,
+        [(200, 600), (400, 200), (404, 100), (421, 100)].into()
+    );
     latencies.sort();
     eprintln!(
         "load: {} requests from {CLIENTS} clients in {seconds:.2} s: {:.0} requests/s, \
-         median {:?}, max {:?}",
+         median {:?}, max {:?}; statuses {statuses:?}",
         latencies.len(),
         latencies.len() as f64 / seconds,
-        latencies[latencies.len() / 2],
-        latencies.last().unwrap()
+        latencies[latencies.len() / 2].0,
+        latencies.last().unwrap().0
     );
     // Still up, and still right.
     let scene = server.get("/api/scene");
@@ -1040,7 +1055,8 @@ fn load_of_1000_requests_from_50_clients_is_answered_and_the_server_stays_up() {
 
 #[test]
 fn ctrl_c_stops_the_server_with_exit_code_130() {
-    let mut server = Server::start(None);
+    let log = tempfile::NamedTempFile::new().unwrap();
+    let mut server = Server::start_with(None, None, log.reopen().unwrap().into());
     assert_eq!(server.get("/api/scene").status, 200);
     let pid = server.child.id().to_string();
     let kill = Command::new("kill").args(["-INT", &pid]).status().unwrap();
@@ -1057,6 +1073,12 @@ fn ctrl_c_stops_the_server_with_exit_code_130() {
     assert!(
         TcpStream::connect(("127.0.0.1", server.port)).is_err(),
         "closed"
+    );
+    // It says it stopped, not what a render interrupted says (it wrote nothing).
+    let said = std::fs::read_to_string(log.path()).unwrap();
+    assert!(
+        said.ends_with("interrupted: the studio stopped (every answer under way was finished)\n"),
+        "{said}"
     );
 }
 
