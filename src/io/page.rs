@@ -15,7 +15,7 @@
 //! float32 of every pixel, the top row first, exactly (the page shows the values
 //! `buffers.exr` holds), packed as [`pack_field`] says: neighbouring pixels have
 //! nearly the same bits, and zlib finds that once the bits are differences, laid
-//! out byte by byte. The built-in scene's six stages at 1920 × 1080 take 2.7 to 5.9
+//! out byte by byte. The built-in scene's six stages at 1920 × 1080 take 3.3 to 7.5
 //! bytes per pixel each, where the 14 float32s in base64 took 74.7 (README, "Limits",
 //! has the command). The page's HTML, CSS and JavaScript are `assets/page/` (plain
 //! files, no build step), copied into `index.html`.
@@ -35,8 +35,9 @@ pub const INDEX_FILE: &str = "index.html";
 pub const PIXELS_FILE: &str = "pixels.js";
 
 /// The largest render whose numbers [`PIXELS_FILE`] holds: 1920 × 1080, where
-/// the built-in scene's six stages' files take 46 MB together. Above it the page still shows the
-/// pictures, and points to `raystep serve`, which tells any pixel of any size.
+/// the built-in scene's six stages' files take 57 MB together. Above it the
+/// page still shows the pictures, and points to `raystep serve`, which tells
+/// any pixel of any size.
 pub const NUMBERS_UP_TO: u64 = 1920 * 1080;
 
 /// Whether a render of `width` × `height` gets a [`PIXELS_FILE`].
@@ -183,8 +184,12 @@ pub fn pack_field(values: &[f32]) -> String {
 }
 // ANCHOR_END: pack_field
 
-/// miniz's level (0 to 10) for [`pack_field`]: 6, zlib's default.
-const ZLIB_LEVEL: u8 = 6;
+/// miniz's level (0 to 10) for [`pack_field`]: 1, the fastest. On the built-in
+/// scene's last stage at 1920 × 1080, level 6 (zlib's default) writes a fifth
+/// less (5.9 bytes per pixel instead of 7.5) in 6.7 times the time (1.9 s
+/// instead of 0.28 s on one thread), which made `raystep stages` at that size
+/// take half as long again.
+const ZLIB_LEVEL: u8 = 1;
 
 /// Append the base64 of `bytes` to `out` (RFC 4648, with `=` padding), by the
 /// `base64` crate.
@@ -371,7 +376,8 @@ mod tests {
         // The sky's depth at 1920 × 1080: 8 MB of float32s.
         let sky = vec![f32::INFINITY; 1920 * 1080];
         let packed = pack_field(&sky);
-        assert!(packed.len() < 20_000, "{} bytes", packed.len());
+        // Under 0.05 bytes a pixel (miniz's fastest level: 50,688 bytes).
+        assert!(packed.len() < 1920 * 1080 / 20, "{} bytes", packed.len());
         assert_eq!(unpack(&packed, sky.len()), sky);
         // Differences that wrap around, signs, zeros, the extremes.
         let odd = [
