@@ -28,13 +28,16 @@ pub enum Error {
     },
     /// Ctrl-C (or SIGTERM) arrived before the files were renamed into place.
     Interrupted,
+    /// Ctrl-C (or SIGTERM) stopped a command that writes no files (`raystep
+    /// serve`), after it closed cleanly: what it says.
+    Stopped(&'static str),
 }
 
 impl Error {
     /// The exit code: [`USER_ERROR`] for a mistake, 130 after an interrupt.
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Interrupted => crate::interrupt::EXIT_CODE,
+            Error::Interrupted | Error::Stopped(_) => crate::interrupt::EXIT_CODE,
             _ => USER_ERROR as u8,
         }
     }
@@ -52,6 +55,7 @@ impl fmt::Display for Error {
                 "interrupted: nothing was written, and the files of the render before \
                  are as they were",
             ),
+            Error::Stopped(what) => write!(f, "interrupted: {what}"),
         }
     }
 }

@@ -30,6 +30,11 @@ impl Server {
 
     /// [`Server::start`] in the folder `dir` (a relative `scene` is in it).
     fn start_in(dir: Option<&Path>, scene: Option<&Path>) -> Server {
+        Server::start_with(dir, scene, Stdio::null())
+    }
+
+    /// [`Server::start_in`], its standard error to `stderr`.
+    fn start_with(dir: Option<&Path>, scene: Option<&Path>, stderr: Stdio) -> Server {
         let mut command = Command::new(env!("CARGO_BIN_EXE_raystep"));
         if let Some(dir) = dir {
             command.current_dir(dir);
@@ -42,7 +47,7 @@ impl Server {
             .args(["--port", "0"])
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
-            .stderr(Stdio::null())
+            .stderr(stderr)
             .spawn()
             .unwrap();
         let stdout = child.stdout.take().unwrap();
@@ -1006,7 +1011,7 @@ fn load_of_1000_requests_from_50_clients_is_answered_and_the_server_stays_up() {
                     };
                     let start = Instant::now();
                     let reply = exchange(port, &request);
-                    latencies.push(start.elapsed());
+                    latencies.push((start.elapsed(), reply.status));
                     assert!(
                         expected.contains(&reply.status),
                         "request {n}: {} for {request:?}",
@@ -1017,20 +1022,30 @@ fn load_of_1000_requests_from_50_clients_is_answered_and_the_server_stays_up() {
             })
         })
         .collect();
-    let mut latencies = Vec::new();
+    let mut latencies: Vec<(Duration, u16)> = Vec::new();
     for thread in threads {
         latencies.extend(thread.join().expect("every request is answered"));
     }
     let seconds = started.elapsed().as_secs_f64();
     assert_eq!(latencies.len(), CLIENTS * EACH);
+    let mut statuses = std::collections::BTreeMap::new();
+    for (_, status) in &latencies {
+        *statuses.entry(*status).or_insert(0) += 1;
+    }
+    // 600 answered, 100 bad options and 100 not HTTP refused with 400, 100
+    // foreign hosts with 421, 100 paths out of the page with 404.
+    assert_eq!(
+        statuses,
+        [(200, 600), (400, 200), (404, 100), (421, 100)].into()
+    );
     latencies.sort();
     eprintln!(
         "load: {} requests from {CLIENTS} clients in {seconds:.2} s: {:.0} requests/s, \
-         median {:?}, max {:?}",
+         median {:?}, max {:?}; statuses {statuses:?}",
         latencies.len(),
         latencies.len() as f64 / seconds,
-        latencies[latencies.len() / 2],
-        latencies.last().unwrap()
+        latencies[latencies.len() / 2].0,
+        latencies.last().unwrap().0
     );
     // Still up, and still right.
     let scene = server.get("/api/scene");
@@ -1040,7 +1055,8 @@ fn load_of_1000_requests_from_50_clients_is_answered_and_the_server_stays_up() {
 
 #[test]
 fn ctrl_c_stops_the_server_with_exit_code_130() {
-    let mut server = Server::start(None);
+    let log = tempfile::NamedTempFile::new().unwrap();
+    let mut server = Server::start_with(None, None, log.reopen().unwrap().into());
     assert_eq!(server.get("/api/scene").status, 200);
     let pid = server.child.id().to_string();
     let kill = Command::new("kill").args(["-INT", &pid]).status().unwrap();
@@ -1057,6 +1073,12 @@ fn ctrl_c_stops_the_server_with_exit_code_130() {
     assert!(
         TcpStream::connect(("127.0.0.1", server.port)).is_err(),
         "closed"
+    );
+    // It says it stopped, not what a render interrupted says (it wrote nothing).
+    let said = std::fs::read_to_string(log.path()).unwrap();
+    assert!(
+        said.ends_with("interrupted: the studio stopped (every answer under way was finished)\n"),
+        "{said}"
     );
 }
 
@@ -1280,6 +1302,9 @@ fn the_studio_page_zooms_compares_drags_tells_a_pixels_story_and_follows_the_fil
     let new_scene = dir.path().join("new.toml");
     let text = raystep::io::scene_file::SEED_TOML;
     std::fs::write(&new_scene, text.replace("radius = 0.7", "radius = 0.5")).unwrap();
+    let broken_scene = dir.path().join("broken.toml");
+    std::fs::write(&broken_scene, text.replace("radius = 0.7", "radius = -1")).unwrap();
+    let broken_error = cli_error(&["check", broken_scene.to_str().unwrap()]);
     // Served by its name in its folder, as a reader would: the page shows it.
     let server = Server::start_in(Some(dir.path()), Some(Path::new("scene.toml")));
     const VIEWPORT: (u32, u32) = (1400, 900);
@@ -1334,6 +1359,8 @@ fn the_studio_page_zooms_compares_drags_tells_a_pixels_story_and_follows_the_fil
         .arg(&scene)
         .arg("--new-scene")
         .arg(&new_scene)
+        .arg("--broken-scene")
+        .arg(&broken_scene)
         .arg("--shots")
         .arg(&shots)
         .arg("--download")
@@ -1441,16 +1468,74 @@ fn the_studio_page_zooms_compares_drags_tells_a_pixels_story_and_follows_the_fil
     // The light moved right only, and the file saved says where it is.
     let before = report["light"]["before"].as_str().unwrap();
     assert_eq!(before, "(5, 5, 5)");
-    let moved: Vec<f64> = light.split(',').map(|v| v.parse().unwrap()).collect();
-    assert!(
-        moved[0] > 5.0 && moved[1] == 5.0 && moved[2] == 5.0,
-        "{moved:?}"
+    // The drags are exact (assets/studio/studio.js, `moveBy`), on the grid of the
+    // picture: the built-in scene's 300 × 200 screen, its pixels' points `across`
+    // and `down` apart (camera.rs's linspace), seen from the eye (0, 0, 1).
+    let rule = &report["light"]["rule"];
+    let numbers = |v: &Value| -> Vec<f64> {
+        let list = v.as_array().unwrap_or_else(|| panic!("{v}"));
+        list.iter().map(|x| x.as_f64().unwrap()).collect()
+    };
+    let screen = raystep::camera::Screen::for_image(300, 200);
+    assert_eq!(
+        numbers(&rule["screen"]),
+        [screen.left, screen.right, screen.top, screen.bottom]
     );
-    // The camera moved up only (dragged up: +y), and its numbers are shown.
-    let moved: Vec<f64> = camera.split(',').map(|v| v.parse().unwrap()).collect();
+    assert_eq!(numbers(&rule["eye"]), [0.0, 0.0, 1.0]);
+    let across = (screen.right - screen.left) / 299.0;
+    let down = (screen.top - screen.bottom) / 199.0;
+    // Where a point is seen in the picture, in pixels (column, row): where the
+    // line from the eye through it meets the screen, on the pixels' grid.
+    let seen = |p: &[f64]| {
+        let k = 1.0 / (1.0 - p[2]);
+        let (x, y) = (p[0] * k, p[1] * k);
+        ((x - screen.left) / across, (screen.top - y) / down)
+    };
+    let close = |a: f64, b: f64, tolerance: f64| (a - b).abs() <= tolerance;
+    for m in rule["moved"].as_array().unwrap() {
+        let (start, end) = (numbers(&m["start"]), numbers(&m["end"]));
+        assert_eq!(end[2], start[2], "z is kept: {m}");
+        if start[2] < 1.0 {
+            // In front of the eye: its image follows the pointer, 30 right, 20 down.
+            let (a, b) = (seen(&start), seen(&end));
+            assert!(
+                close(b.0 - a.0, 30.0, 1e-9) && close(b.1 - a.1, 20.0, 1e-9),
+                "{m}: seen {a:?} then {b:?}"
+            );
+        } else {
+            // Level with the eye: no image; the screen's steps.
+            let step = [end[0] - start[0], end[1] - start[1]];
+            assert!(
+                close(step[0], 30.0 * across, 1e-12) && close(step[1], -20.0 * down, 1e-12),
+                "{m}"
+            );
+        }
+    }
+    // The camera: as far as the pointer went over the screen, so the ray through
+    // the pixel now under the pointer has the direction of the one under it before.
+    let eye = numbers(&rule["camera"]);
     assert!(
-        moved[0] == 0.0 && moved[1] > 0.0 && moved[2] == 1.0,
-        "{moved:?}"
+        close(eye[0], 30.0 * across, 1e-12) && close(eye[1], -20.0 * down, 1e-12),
+        "{eye:?}"
+    );
+    assert_eq!(eye[2], 1.0);
+    // The light the test dragged 80 screen pixels right lies behind the eye
+    // (z = 5): it moved by (1 − 5)/1 = 4 times the screen's steps, right only
+    // (the page sends 4 decimals).
+    let zoom = report["light"]["zoom"].as_f64().unwrap();
+    let moved: Vec<f64> = light.split(',').map(|v| v.parse().unwrap()).collect();
+    let expected = 5.0 + 80.0 / zoom * across * 4.0;
+    assert!(
+        close(moved[0], expected, 0.5e-4 + 1e-12) && moved[1] == 5.0 && moved[2] == 5.0,
+        "{moved:?}, expected x {expected}"
+    );
+    // The camera dragged 40 screen pixels up: up by 40 rows of the screen.
+    let zoom = report["camera"]["zoom"].as_f64().unwrap();
+    let moved: Vec<f64> = camera.split(',').map(|v| v.parse().unwrap()).collect();
+    let expected = 40.0 / zoom * down;
+    assert!(
+        moved[0] == 0.0 && close(moved[1], expected, 0.5e-4 + 1e-12) && moved[2] == 1.0,
+        "{moved:?}, expected y {expected}"
     );
     let shown = report["camera"]["shown"].as_str().unwrap();
     assert_eq!(shown, format!("(0, {}, 1) moved", moved[1]));
@@ -1462,7 +1547,18 @@ fn the_studio_page_zooms_compares_drags_tells_a_pixels_story_and_follows_the_fil
     // The scene file was the built-in scene when it was saved.
     let api = Server::start(None).get(&format!("/api/render?light={light}"));
     assert!(api.body == std::fs::read(out.join("beauty.png")).unwrap());
-    assert_eq!(report["version"], "2");
+    // The broken file: the command line's message in the page (its file, line and
+    // key; the page was given the file by the name `scene.toml`), the last good
+    // picture kept; then the new file, version 3.
+    let shown = report["broken"]["error"].as_str().unwrap();
+    let message = broken_error.replace(broken_scene.to_str().unwrap(), "scene.toml");
+    assert!(shown.contains(&message), "{shown:?} lacks {message:?}");
+    assert!(
+        shown.contains("the picture is of the last scene that loaded"),
+        "{shown}"
+    );
+    assert_eq!(report["broken"]["state"], "ready");
+    assert_eq!(report["version"], "3");
 
     // The screenshots: PNGs of the window's size, not one flat colour; a copy
     // stays in target/ for a person to look at.

@@ -23,23 +23,31 @@ const BUFFER_OF = {
 //
 // Browsers refuse fetch() of local files, but they do run a local <script src>.
 // So each stage's numbers are a script, <stage>/pixels.js, which calls
-//   raystepPixels.load("06-plane", {width, height, fields, data})
-// where data is base64 of little-endian float32s: pixel after pixel, the top row
-// first, one float per field. The page adds that script when the stage is chosen.
+//   raystepPixels.load("06-plane", {width, height, fields: [{name, data}, ...]})
+// with an entry for each field the stage computed. raystep packs each field's
+// float32s (src/io/page.rs, pack_field): the differences of neighbouring pixels'
+// bits, their bytes laid out plane by plane, then zlib, then base64. unpack()
+// undoes it, exactly: the page shows the float32s buffers.exr holds.
 
-// folder -> "loading" | "failed" | {width, height, fields, view}
+// folder -> "loading" | "failed" | {width, height, values: {field: Float32Array}}
 const stageData = new Map();
 
 window.raystepPixels = {
   load(folder, info) {
-    const bytes = base64Bytes(info.data);
-    stageData.set(folder, {
-      width: info.width,
-      height: info.height,
-      fields: info.fields,
-      view: new DataView(bytes.buffer),
-    });
-    show();
+    const count = info.width * info.height;
+    Promise.all(info.fields.map((field) => unpack(field.data, count)))
+      .then((planes) => {
+        const values = {};
+        info.fields.forEach((field, i) => {
+          values[field.name] = planes[i];
+        });
+        stageData.set(folder, { width: info.width, height: info.height, values });
+      })
+      .catch((error) => {
+        stageData.set(folder, "failed");
+        console.warn("cannot read " + folder + "/pixels.js: " + error);
+      })
+      .finally(show);
   },
 };
 
@@ -50,6 +58,26 @@ function base64Bytes(text) {
     bytes[i] = binary.charCodeAt(i);
   }
   return bytes;
+}
+
+// One field's `count` float32s from its packed text: base64, then zlib (the
+// browser's own DecompressionStream), then the bytes of each difference taken
+// from the four planes and added to the value before.
+async function unpack(text, count) {
+  const zlib = new Blob([base64Bytes(text)]).stream().pipeThrough(new DecompressionStream("deflate"));
+  const planes = new Uint8Array(await new Response(zlib).arrayBuffer());
+  if (planes.length !== 4 * count) {
+    throw new Error(planes.length + " bytes, not " + 4 * count);
+  }
+  const bits = new Uint32Array(count);
+  let before = 0;
+  for (let i = 0; i < count; i++) {
+    const difference =
+      planes[i] | (planes[count + i] << 8) | (planes[2 * count + i] << 16) | (planes[3 * count + i] << 24);
+    before = (before + difference) >>> 0; // wrapping, as raystep subtracted
+    bits[i] = before;
+  }
+  return new Float32Array(bits.buffer); // the same bits, read as float32s
 }
 
 function loadStage(folder) {
@@ -70,14 +98,12 @@ function loadStage(folder) {
   document.head.append(script);
 }
 
-// Every field of pixel (x, y), as numbers.
+// Every field of pixel (x, y) the stage computed, as numbers.
 function pixelValues(data, x, y) {
-  const stride = data.fields.length * 4; // bytes per pixel
-  const start = (y * data.width + x) * stride;
   const values = {};
-  data.fields.forEach((field, i) => {
-    values[field] = data.view.getFloat32(start + 4 * i, true); // true: little-endian
-  });
+  for (const [field, plane] of Object.entries(data.values)) {
+    values[field] = plane[y * data.width + x];
+  }
   return values;
 }
 
@@ -239,12 +265,17 @@ function show() {
     status =
       "This render is too large for the page to hold its numbers (pixels.js is written up to " +
       MANIFEST.numbersUpTo +
-      " pixels). Read a pixel with raystep explain --pixel " +
+      " pixels). Read any pixel in the studio: raystep serve, then open the address it prints" +
+      " and click the pixel; or raystep explain --pixel " +
       (pointer ? pointer.x + "," + pointer.y : "X,Y") +
-      " (and the same size flags), or open buffers.exr.";
+      " (and the same size flags); or open buffers.exr.";
   } else if (data === "failed") {
     state = "error";
-    status = "Cannot load " + folder + "/pixels.js: run raystep stages again to write it.";
+    status =
+      "Cannot read " +
+      folder +
+      "/pixels.js: run raystep stages again to write it (a browser older than 2023 may lack the" +
+      " DecompressionStream it needs).";
   } else if (!pointer) {
     state = "empty";
     status = "Point at the picture to read a pixel.";
@@ -257,7 +288,7 @@ function show() {
     for (const cell of fieldCells) {
       const field = cell.dataset.field;
       const v = values[field];
-      const computed = chosen.stage.buffers.includes(BUFFER_OF[field]);
+      const computed = chosen.stage.buffers.includes(BUFFER_OF[field]) && field in values;
       cell.dataset.value = String(v); // exact: the float32 as JavaScript prints it
       cell.dataset.computed = String(computed);
       cell.textContent = computed ? describe(field, v) : "—";

@@ -23,7 +23,7 @@ const VIEW = { b: `${tab}-b`, a: `${tab}-a`, diff: `${tab}-d` };
 
 let scene = null; // /api/scene's "scene"
 const moves = { light: null, camera: null }; // positions the page moved, or null
-let current = null; // the picture: {query, buffer, image, width, height}
+let current = null; // the picture: {query, buffer, image, width, height, screen, eye}
 let pinned = null; // A: {options, label, buffer, image}
 let abFigures = null;
 let selected = null; // the pixel whose story is shown, {x, y}
@@ -131,7 +131,16 @@ async function render() {
   const buffers = (response.headers.get("X-Raystep-Buffers") || "").split(",");
   for (const option of bufferSelect.options) option.disabled = !buffers.includes(option.value);
   const sized = !current || current.width !== image.width || current.height !== image.height;
-  current = { query: query.toString(), buffer: bufferSelect.value, image, width: image.width, height: image.height };
+  const numbers = (header) => (response.headers.get(header) || "").split(",").map(Number);
+  current = {
+    query: query.toString(),
+    buffer: bufferSelect.value,
+    image,
+    width: image.width,
+    height: image.height,
+    screen: numbers("X-Raystep-Screen"),
+    eye: numbers("X-Raystep-Camera"),
+  };
   if (sized && view.fitted) fit();
   draw();
   const ms = Math.round(performance.now() - started);
@@ -318,16 +327,38 @@ function showPositions() {
   $("save-as").href = `/api/scene.toml${query.size ? `?${query}` : ""}`;
 }
 
-// World units per pixel of the picture at the depth of what moves: the screen's
-// width over the picture's, scaled by how much farther from the camera it is
-// than the screen (z = 0) for the light.
-function worldPerPixel(what, start) {
-  const s = scene.screen;
-  const perPixel = (s.right - s.left) / current.width;
-  if (what === "camera") return perPixel;
-  const camera = moves.camera || scene.camera;
-  const toScreen = Math.abs(camera[2]) || 1;
-  return perPixel * Math.max(1, Math.abs(start[2] - camera[2]) / toScreen);
+// Where a drag of (dx, dy) pixels of the picture (right and down) takes the
+// light or the camera from `start`: parallel to the screen (x and y; z kept), by
+// an exact amount read from the grid the picture was rendered on. The render's
+// headers say which: X-Raystep-Screen (the rectangle at z = 0, left, right, top,
+// bottom) and X-Raystep-Camera (the eye). camera.rs's pixels look at
+// linspace(left, right, width) across and linspace(top, bottom, height) down, so
+// neighbouring pixels' points on the screen are `across` and `down` apart.
+// - The camera moves by the pixels dragged times those steps: the eye slides as
+//   far as the pointer slid over the screen, and the ray through the pixel now
+//   under the pointer is the ray that was under it at the start, moved without
+//   turning. The screen stays (raystep's screen does not move with the eye), so
+//   what lies on it stays put, what lies far beyond it follows the pointer, and
+//   what lies between slides by the parallax of a head moving before a window.
+// - The light moves so that its image (where the line from the eye through it
+//   meets the screen) follows the pointer exactly: a point at depth z is seen at
+//   eye + (point - eye) * e / (e - z), e the eye's z, so one step on the screen is
+//   (e - z) / e steps in the light's plane. A light behind the eye (that ratio
+//   below 0) has no image in the picture; it moves by the ratio's size all the
+//   same, so that seen from the eye it turns by as much as a light in front at
+//   its distance would. Level with the eye (ratio 0) it would not move: it moves
+//   by the screen's steps then.
+// tests/serve.rs checks both against camera.rs's projection, pixel for pixel.
+function moveBy(what, start, dx, dy) {
+  const [left, right, top, bottom] = current.screen;
+  const across = current.width > 1 ? (right - left) / (current.width - 1) : 0;
+  const down = current.height > 1 ? (top - bottom) / (current.height - 1) : 0;
+  let ratio = 1;
+  if (what === "light") {
+    const e = current.eye[2];
+    ratio = Math.abs((e - start[2]) / e) || 1;
+  }
+  return [start[0] + dx * across * ratio, start[1] - dy * down * ratio, start[2]];
 }
 
 // ---- Pointer: drag pans or moves, a click picks a pixel ----
@@ -356,9 +387,7 @@ frameBox.addEventListener("pointermove", (event) => {
     place();
     return;
   }
-  const unit = worldPerPixel(press.mode, press.start) / view.zoom;
-  const p = press.start;
-  moves[press.mode] = [p[0] + dx * unit, p[1] - dy * unit, p[2]];
+  moves[press.mode] = moveBy(press.mode, press.start, dx / view.zoom, dy / view.zoom);
   showPositions();
   clearTimeout(moveTimer);
   moveTimer = setTimeout(render, 30);

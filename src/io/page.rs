@@ -7,18 +7,24 @@
 //! JavaScript file that hands them to the page:
 //!
 //! ```text
-//! raystepPixels.load("06-plane", {"width": W, "height": H, "fields": ["R", …], "data": "<base64>"});
+//! raystepPixels.load("06-plane", {"width": W, "height": H, "fields": [{"name": "R", "data": "<base64>"}, …]});
 //! ```
 //!
-//! `data` is base64 of little-endian float32s, pixel after pixel, the top row
-//! first, one float per field ([`FIELDS`]). The page's HTML, CSS and JavaScript are
-//! `assets/page/` (plain files, no build step), copied into `index.html`.
+//! One entry per field ([`FIELDS`]) that the stage computed (the page shows "—"
+//! for the others, so their numbers are not written). Each field's `data` holds its
+//! float32 of every pixel, the top row first, exactly (the page shows the values
+//! `buffers.exr` holds), packed as [`pack_field`] says: neighbouring pixels have
+//! nearly the same bits, and zlib finds that once the bits are differences, laid
+//! out byte by byte. The built-in scene's six stages at 1920 × 1080 take 3.3 to 7.5
+//! bytes per pixel each, where the 14 float32s in base64 took 74.7 (README, "Limits",
+//! has the command). The page's HTML, CSS and JavaScript are `assets/page/` (plain
+//! files, no build step), copied into `index.html`.
 
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::aov::{Buffer, Frame, NO_OBJECT};
+use crate::aov::{Buffer, Frame, PixelRecord, NO_OBJECT};
 use crate::error::Error;
 use crate::io::output::Pending;
 
@@ -28,10 +34,10 @@ pub const INDEX_FILE: &str = "index.html";
 /// The numbers of a stage, in the stage's folder.
 pub const PIXELS_FILE: &str = "pixels.js";
 
-/// The largest render whose numbers [`PIXELS_FILE`] holds: 1920 × 1080. Its
-/// file takes 75 bytes per pixel (14 float32s in base64: 155 MB at this size,
-/// per stage); above it the
-/// page still shows the pictures, and says where to read the numbers instead.
+/// The largest render whose numbers [`PIXELS_FILE`] holds: 1920 × 1080, where
+/// the built-in scene's six stages' files take 57 MB together. Above it the
+/// page still shows the pictures, and points to `raystep serve`, which tells
+/// any pixel of any size.
 pub const NUMBERS_UP_TO: u64 = 1920 * 1080;
 
 /// Whether a render of `width` × `height` gets a [`PIXELS_FILE`].
@@ -39,10 +45,24 @@ pub fn has_numbers(width: u32, height: u32) -> bool {
     u64::from(width) * u64::from(height) <= NUMBERS_UP_TO
 }
 
-/// The floats of each pixel in [`PIXELS_FILE`], in order.
-pub const FIELDS: [&str; 14] = [
-    "R", "G", "B", "depth", "N.X", "N.Y", "N.Z", "P.X", "P.Y", "P.Z", "shadow", "object",
-    "bounces", "rays",
+/// The fields of each pixel the page shows, in order, and the buffer whose
+/// stage computes each: a stage that does not write the buffer gets no numbers
+/// for the field.
+pub const FIELDS: [(&str, Buffer); 14] = [
+    ("R", Buffer::Beauty),
+    ("G", Buffer::Beauty),
+    ("B", Buffer::Beauty),
+    ("depth", Buffer::Depth),
+    ("N.X", Buffer::Normal),
+    ("N.Y", Buffer::Normal),
+    ("N.Z", Buffer::Normal),
+    ("P.X", Buffer::Position),
+    ("P.Y", Buffer::Position),
+    ("P.Z", Buffer::Position),
+    ("shadow", Buffer::Shadow),
+    ("object", Buffer::Object),
+    ("bounces", Buffer::Bounces),
+    ("rays", Buffer::Rays),
 ];
 
 const TEMPLATE: &str = include_str!("../../assets/page/index.html");
@@ -64,10 +84,16 @@ pub struct PageStage {
 /// The floats of pixel (`row`, `col`), in the order of [`FIELDS`]. On a miss:
 /// depth `+∞`, normal and position `(0, 0, 0)`, shadow `−1`, object `−1` (as in
 /// `buffers.exr`).
+#[cfg(test)]
 fn pixel_fields(frame: &Frame, row: u32, col: u32) -> [f32; 14] {
-    let p = frame.at(row, col);
+    let mut fields = record_fields(frame.at(row, col));
+    fields[7..10].copy_from_slice(&frame.position(row, col));
+    fields
+}
+
+/// [`pixel_fields`] but the position, which needs the primary ray (left 0 here).
+fn record_fields(p: &PixelRecord) -> [f32; 14] {
     let [r, g, b] = p.colour;
-    let [px, py, pz] = frame.position(row, col);
     let [nx, ny, nz] = p.normal;
     let object = if p.object == NO_OBJECT {
         -1.0
@@ -76,41 +102,94 @@ fn pixel_fields(frame: &Frame, row: u32, col: u32) -> [f32; 14] {
     };
     let (bounces, rays) = (p.bounces as f32, p.rays as f32);
     [
-        r, g, b, p.depth, nx, ny, nz, px, py, pz, p.shadow, object, bounces, rays,
+        r, g, b, p.depth, nx, ny, nz, 0.0, 0.0, 0.0, p.shadow, object, bounces, rays,
     ]
 }
 
-/// The contents of `folder/pixels.js` for `frame`: every field of every pixel.
-pub fn pixels_js(folder: &str, frame: &Frame) -> String {
-    let folder = serde_json::to_string(folder).expect("a string is valid JSON");
-    let fields = serde_json::to_string(&FIELDS).expect("strings are valid JSON");
-    let floats = frame.pixels.len() * FIELDS.len();
-    let mut js = String::with_capacity((floats * 4).div_ceil(3) * 4 + 300);
-    js.push_str("// The numbers of every pixel, for index.html. Written by raystep stages.\n");
-    js.push_str(&format!(
-        "raystepPixels.load({folder}, {{\"width\": {}, \"height\": {}, \"fields\": {fields}, \"data\": \"",
-        frame.width, frame.height
-    ));
-    // Three pixels are 168 bytes, a multiple of 3: encoded 3 × 256 pixels at a
-    // time, the base64 is the same as the whole at once, without holding all the
-    // bytes.
-    const GROUP: usize = 256 * 3 * FIELDS.len() * 4;
-    let mut group = Vec::with_capacity(GROUP);
+/// Field `i` of [`FIELDS`] of every pixel, the top row first: the `i`-th float
+/// of [`pixel_fields`], the primary ray computed only for the position's.
+fn field_values(frame: &Frame, i: usize) -> Vec<f32> {
+    let mut values = Vec::with_capacity(frame.pixels.len());
     for row in 0..frame.height {
         for col in 0..frame.width {
-            for v in pixel_fields(frame, row, col) {
-                group.extend_from_slice(&v.to_le_bytes());
-            }
-            if group.len() == GROUP {
-                base64_into(&mut js, &group);
-                group.clear();
-            }
+            values.push(if (7..10).contains(&i) {
+                frame.position(row, col)[i - 7]
+            } else {
+                record_fields(frame.at(row, col))[i]
+            });
         }
     }
-    base64_into(&mut js, &group);
-    js.push_str("\"});\n");
+    values
+}
+
+/// The contents of `folder/pixels.js` for `frame`: every field the stage
+/// computed, of every pixel, each packed by [`pack_field`] (the fields in
+/// parallel: the same bytes whatever the number of threads).
+pub fn pixels_js(folder: &str, frame: &Frame) -> String {
+    use rayon::prelude::*;
+    let fields: Vec<(&str, String)> = FIELDS
+        .par_iter()
+        .enumerate()
+        .filter(|(_, (_, buffer))| frame.has(*buffer))
+        .map(|(i, (name, _))| (*name, pack_field(&field_values(frame, i))))
+        .collect();
+    let mut js =
+        String::from("// The numbers of every pixel, for index.html. Written by raystep stages.\n");
+    let folder = serde_json::to_string(folder).expect("a string is valid JSON");
+    js.push_str(&format!(
+        "raystepPixels.load({folder}, {{\"width\": {}, \"height\": {}, \"fields\": [",
+        frame.width, frame.height
+    ));
+    for (i, (name, data)) in fields.iter().enumerate() {
+        let sep = if i == 0 { "\n" } else { ",\n" };
+        js.push_str(&format!(
+            "{sep}{{\"name\": \"{name}\", \"data\": \"{data}\"}}"
+        ));
+    }
+    js.push_str("\n]});\n");
     js
 }
+
+// ANCHOR: pack_field
+/// One field's float32s (one per pixel, in reading order) as the page reads
+/// them, exactly, in few bytes:
+///
+/// 1. each value's 32 bits less the bits of the value before it (wrapping; the
+///    first less 0): neighbours are alike, so the differences are small
+///    numbers, and a flat area (the sky, a field the stage leaves constant) is
+///    zeros;
+/// 2. the differences' lowest bytes first (every pixel's), then their second
+///    bytes, third, and highest: runs of like bytes (the high bytes of small
+///    differences are 0 or 255);
+/// 3. compressed with zlib (RFC 1950, what a browser's
+///    `DecompressionStream("deflate")` reads), then written in base64.
+///
+/// The page undoes the three in reverse (`assets/page/page.js`, `unpack`).
+pub fn pack_field(values: &[f32]) -> String {
+    let n = values.len();
+    let mut planes = vec![0u8; 4 * n];
+    let mut before = 0u32;
+    for (i, v) in values.iter().enumerate() {
+        let bits = v.to_bits();
+        let difference = bits.wrapping_sub(before).to_le_bytes();
+        before = bits;
+        for (plane, byte) in difference.into_iter().enumerate() {
+            planes[plane * n + i] = byte;
+        }
+    }
+    let zlib = miniz_oxide::deflate::compress_to_vec_zlib(&planes, ZLIB_LEVEL);
+    let mut out = String::with_capacity(zlib.len().div_ceil(3) * 4);
+    base64_into(&mut out, &zlib);
+    out
+}
+// ANCHOR_END: pack_field
+
+/// miniz's level (0 to 10) for [`pack_field`]: 1, the fastest. On the built-in
+/// scene's last stage at 1920 × 1080, level 6 (zlib's default) writes a fifth
+/// less (5.9 bytes per pixel instead of 7.5) in 6.7 times the time (1.9 s
+/// instead of 0.28 s on one thread), which made `raystep stages` at that size
+/// take half as long again.
+const ZLIB_LEVEL: u8 = 1;
 
 /// Append the base64 of `bytes` to `out` (RFC 4648, with `=` padding), by the
 /// `base64` crate.
@@ -221,23 +300,100 @@ mod tests {
         crate::render::render(&scene, &Stages::up_to(last).into(), &|_| {})
     }
 
+    /// What the page's `unpack` does: base64, zlib, the bytes of each difference
+    /// from the four planes, added to the bits before.
+    fn unpack(data: &str, count: usize) -> Vec<f32> {
+        use base64::Engine as _;
+        let zlib = base64::engine::general_purpose::STANDARD
+            .decode(data)
+            .expect("base64");
+        let planes = miniz_oxide::inflate::decompress_to_vec_zlib(&zlib).expect("zlib");
+        assert_eq!(planes.len(), 4 * count);
+        let mut before = 0u32;
+        (0..count)
+            .map(|i| {
+                let difference = u32::from_le_bytes([0, 1, 2, 3].map(|k| planes[k * count + i]));
+                before = before.wrapping_add(difference);
+                f32::from_bits(before)
+            })
+            .collect()
+    }
+
+    /// The call `pixels_js` writes: its folder, and its object.
+    fn call(js: &str) -> (String, serde_json::Value) {
+        let (comment, call) = js.split_once('\n').expect("a comment line");
+        assert!(comment.starts_with("// "), "{comment}");
+        let args = call
+            .strip_prefix("raystepPixels.load(")
+            .and_then(|c| c.strip_suffix(");\n"))
+            .expect("one call");
+        let args: serde_json::Value = serde_json::from_str(&format!("[{args}]")).expect("JSON");
+        (args[0].as_str().unwrap().to_string(), args[1].clone())
+    }
+
     #[test]
-    fn pixels_js_holds_every_field_of_every_pixel_top_row_first() {
-        // 7 × 5: 35 pixels, not a multiple of the groups of three.
-        let frame = frame(7, 5, Stage::Plane);
-        let js = pixels_js("06-plane", &frame);
-        let prefix = "raystepPixels.load(\"06-plane\", {\"width\": 7, \"height\": 5, \"fields\": \
-            [\"R\",\"G\",\"B\",\"depth\",\"N.X\",\"N.Y\",\"N.Z\",\"P.X\",\"P.Y\",\"P.Z\",\"shadow\",\"object\",\"bounces\",\"rays\"], \
-            \"data\": \"";
-        let start = js.find(prefix).expect("the call") + prefix.len();
-        let end = js.rfind("\"});").expect("the end of the call");
-        let bytes: Vec<u8> = (0..frame.height)
-            .flat_map(|row| (0..frame.width).map(move |col| (row, col)))
-            .flat_map(|(row, col)| pixel_fields(&frame, row, col))
-            .flat_map(f32::to_le_bytes)
+    fn pixels_js_holds_every_field_the_stage_computed_of_every_pixel_exactly() {
+        // 7 × 5: 35 pixels, and the last stage computes every field.
+        let plane = frame(7, 5, Stage::Plane);
+        let (folder, info) = call(&pixels_js("06-plane", &plane));
+        assert_eq!(folder, "06-plane");
+        assert_eq!(
+            (info["width"].as_u64(), info["height"].as_u64()),
+            (Some(7), Some(5))
+        );
+        let fields = info["fields"].as_array().unwrap();
+        let names: Vec<&str> = fields.iter().map(|f| f["name"].as_str().unwrap()).collect();
+        assert_eq!(names, FIELDS.map(|(name, _)| name));
+        for (i, field) in fields.iter().enumerate() {
+            let values = unpack(field["data"].as_str().unwrap(), 35);
+            for (n, v) in values.iter().enumerate() {
+                let (row, col) = (n as u32 / 7, n as u32 % 7);
+                let expected = pixel_fields(&plane, row, col)[i];
+                // The same bits: -0 stays -0, +∞ stays +∞.
+                assert_eq!(
+                    v.to_bits(),
+                    expected.to_bits(),
+                    "{} at ({col}, {row})",
+                    names[i]
+                );
+            }
+        }
+        // The first stage writes the picture and the rays' directions: only the
+        // colour's fields, whose values the page shows.
+        let rays = frame(7, 5, Stage::Rays);
+        let (_, info) = call(&pixels_js("01-rays", &rays));
+        let names: Vec<&str> = info["fields"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f["name"].as_str().unwrap())
             .collect();
-        assert_eq!(bytes.len(), 35 * 14 * 4);
-        assert_eq!(&js[start..end], base64(&bytes));
+        assert_eq!(names, ["R", "G", "B"]);
+    }
+
+    #[test]
+    fn a_flat_field_packs_to_almost_nothing_and_any_bits_come_back() {
+        // The sky's depth at 1920 × 1080: 8 MB of float32s.
+        let sky = vec![f32::INFINITY; 1920 * 1080];
+        let packed = pack_field(&sky);
+        // Under 0.05 bytes a pixel (miniz's fastest level: 50,688 bytes).
+        assert!(packed.len() < 1920 * 1080 / 20, "{} bytes", packed.len());
+        assert_eq!(unpack(&packed, sky.len()), sky);
+        // Differences that wrap around, signs, zeros, the extremes.
+        let odd = [
+            0.0,
+            -0.0,
+            f32::MAX,
+            -f32::MAX,
+            f32::MIN_POSITIVE,
+            1.0,
+            -1.0,
+            f32::NEG_INFINITY,
+            0.1,
+        ];
+        let back = unpack(&pack_field(&odd), odd.len());
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&back), bits(&odd));
     }
 
     #[test]

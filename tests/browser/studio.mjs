@@ -7,14 +7,15 @@
 // Used by tests/serve.rs.
 //
 //   node tests/browser/studio.mjs --url http://127.0.0.1:PORT/ --screenshot SHOT.png \
-//       --scene SCENE.toml --new-scene NEW.toml --shots DIR --download FILE \
+//       --scene SCENE.toml --new-scene NEW.toml --broken-scene BROKEN.toml --shots DIR --download FILE \
 //       [--chromium /usr/bin/chromium] [--size 1400x1000] --pixel X,Y
 //
 // Writes the book's screenshots into DIR (studio-*.png) and the scene the page
 // saves as FILE. Prints one JSON object on stdout:
 //   {console, pageErrors, failedRequests, steps: [{action, query, state}],
 //    refusal, story: {x, y, json}, zoom: {zoom, x, y}, ab: {figures, a, b},
-//    light: {before, after}, saved, version, screenshot, shots}
+//    light: {before, after, sent, zoom, rule}, camera: {zoom, shown, sent}, saved,
+//    version, screenshot, shots}
 
 import { copyFileSync, mkdirSync } from "node:fs";
 import { join } from "node:path";
@@ -26,7 +27,7 @@ function parseArguments(argv) {
     if (!argv[i].startsWith("--")) throw new Error(`unexpected ${argv[i]}`);
     options[argv[i].slice(2)] = argv[i + 1];
   }
-  for (const key of ["url", "screenshot", "scene", "new-scene", "pixel", "shots", "download"]) {
+  for (const key of ["url", "screenshot", "scene", "new-scene", "broken-scene", "pixel", "shots", "download"]) {
     if (!options[key]) throw new Error(`--${key} is needed`);
   }
   const [width, height] = options.size.split("x").map(Number);
@@ -197,6 +198,20 @@ async function main() {
       before,
       after: await page.locator("#light-position").textContent(),
       sent: await page.locator("#drag").getAttribute("data-light"),
+      zoom: Number(await page.locator("#frame").getAttribute("data-zoom")),
+      // The page's rule for other lights (30 pixels right, 20 down), for the
+      // test to project: in front of the eye, beyond the screen and before it,
+      // and level with the eye.
+      rule: await page.evaluate(() => ({
+        screen: current.screen,
+        eye: current.eye,
+        size: [current.width, current.height],
+        moved: [[0.5, 0.5, -2], [-0.25, 0.1, 0.5], [1, 1, 1]].map((start) => ({
+          start,
+          end: moveBy("light", start, 30, 20),
+        })),
+        camera: moveBy("camera", [0, 0, 1], 30, 20),
+      })),
     };
     await shot(page, "light");
 
@@ -213,6 +228,7 @@ async function main() {
     await page.waitForFunction(() => (document.body.dataset.query || "").includes("camera="));
     report.steps.push({ action: "camera dragged", ...(await settled(page, "ready")) });
     report.camera = {
+      zoom: Number(await page.locator("#frame").getAttribute("data-zoom")),
       shown: await page.locator("#camera-position").textContent(),
       sent: await page.locator("#drag").getAttribute("data-camera"),
     };
@@ -222,10 +238,23 @@ async function main() {
     await page.waitForFunction(() => (document.body.dataset.query || "").includes("buffer=depth"));
     report.steps.push({ action: "depth again", ...(await settled(page, "ready")) });
 
+    // Save a scene file that no longer loads: the page shows the command line's
+    // message and keeps the last good picture.
+    copyFileSync(options["broken-scene"], options.scene);
+    await page.waitForFunction(
+      () => document.body.dataset.version === "2" && !document.getElementById("scene-error").hidden,
+      null,
+      { timeout: 15000 },
+    );
+    report.broken = {
+      error: await page.locator("#scene-error").textContent(),
+      state: await page.evaluate(() => document.body.dataset.state),
+    };
+
     // Save a new scene file: the page reloads it through the event stream.
     copyFileSync(options["new-scene"], options.scene);
     await page.waitForFunction(
-      () => document.body.dataset.sceneVersion === "2" && document.body.dataset.state === "ready",
+      () => document.body.dataset.sceneVersion === "3" && document.body.dataset.state === "ready",
       null,
       { timeout: 15000 },
     );

@@ -14,7 +14,7 @@
 //!   (`Sec-Fetch-Site`);
 //! - the only paths are the page's own files, compiled into the binary, and the
 //!   API: nothing is ever read from the disk for a path, so `/../`, encoded dots
-//!   and absolute paths are 404;
+//!   and absolute paths are 404, and no symbolic link is followed;
 //! - a query is at most [`api::MAX_QUERY_BYTES`], an image and its samples are
 //!   bounded by the command line's limits, and at most [`RENDERS_AT_ONCE`]
 //!   renders (and [`MAX_PIXELS`] pixels) are in flight: others wait in line, up
@@ -135,7 +135,9 @@ pub fn run(args: &ServeArgs) -> Result<(), Error> {
     }
     let _ = watcher.join();
     drop(server);
-    Err(Error::Interrupted)
+    Err(Error::Stopped(
+        "the studio stopped (every answer under way was finished)",
+    ))
 }
 
 /// Start the system's browser on `url`, or say how to open it by hand.
@@ -601,6 +603,16 @@ fn render(shared: &Shared, request: Request, query: &str) {
             "X-Raystep-Size",
             format!("{}x{}", job.scene.width, job.scene.height),
         ),
+        // The screen and the eye this render looked through, for the page's
+        // drags (each number as Rust prints it: read back, the same f64).
+        ("X-Raystep-Screen", {
+            let s = job.scene.camera().screen;
+            format!("{},{},{},{}", s.left, s.right, s.top, s.bottom)
+        }),
+        ("X-Raystep-Camera", {
+            let [x, y, z] = job.scene.camera.to_array();
+            format!("{x},{y},{z}")
+        }),
     ];
     send(request, 200, "image/png", done.png, &extra);
 }
