@@ -386,3 +386,56 @@ fn the_same_bytes_on_one_thread_and_on_four() {
     };
     assert_eq!(files(1, &one), files(4, &four));
 }
+
+/// The files of a render are written in one pass, a window of scan lines at a
+/// time (the EXR's blocks and every picture's rows, the PNGs streamed): each PNG
+/// holds the picture `visualise` draws and the EXR the bytes `exr_bytes_as`
+/// gives, in one-line blocks (no compression) and 16-line ones (ZIP), over
+/// several windows (300 lines at 130 wide is two), and every file's bytes are the
+/// same on one thread and on three.
+#[test]
+fn the_files_written_hold_the_pictures_and_the_exr_on_any_thread_count() {
+    use raystep::io::output::{exr_bytes_as, visualise, ExrCompression, Pending};
+    let frame = common::render(&common::seed(130, 300), Stages::ALL);
+    for compression in [ExrCompression::None, ExrCompression::Zip] {
+        let write = |threads: usize| {
+            let dir = tempfile::tempdir().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut pending = Pending::new().with_exr(compression);
+                pending.folder(dir.path()).unwrap();
+                let paths = pending.frame(&frame, dir.path()).unwrap();
+                pending.commit().unwrap();
+                paths
+                    .iter()
+                    .map(|p| (p.clone(), std::fs::read(p).unwrap()))
+                    .collect::<Vec<_>>()
+            })
+        };
+        let (one, three) = (write(1), write(3));
+        let bytes = |files: &[(std::path::PathBuf, Vec<u8>)]| {
+            files.iter().map(|(_, b)| b.clone()).collect::<Vec<_>>()
+        };
+        assert_eq!(bytes(&one), bytes(&three), "{compression:?}");
+        let (exr, pngs) = one.split_last().unwrap();
+        assert!(exr.0.ends_with("buffers.exr"));
+        assert!(
+            exr.1 == exr_bytes_as(&frame, compression).unwrap(),
+            "{compression:?}: buffers.exr differs from exr_bytes_as"
+        );
+        assert_eq!(pngs.len(), frame.buffers().count());
+        for ((path, png), buffer) in pngs.iter().zip(frame.buffers()) {
+            assert!(path.ends_with(format!("{}.png", buffer.name())));
+            let decoded = image::load_from_memory(png).unwrap().to_rgb8();
+            assert_eq!(decoded.dimensions(), (130, 300));
+            assert!(
+                decoded.into_raw() == visualise(&frame, buffer),
+                "{}: the file's pixels differ from visualise",
+                buffer.name()
+            );
+        }
+    }
+}
