@@ -106,20 +106,16 @@ fn record_fields(p: &PixelRecord) -> [f32; 14] {
     ]
 }
 
-/// Field `i` of [`FIELDS`] of every pixel, the top row first: the `i`-th float
-/// of [`pixel_fields`], the primary ray computed only for the position's.
-fn field_values(frame: &Frame, i: usize) -> Vec<f32> {
-    let mut values = Vec::with_capacity(frame.pixels.len());
-    for row in 0..frame.height {
-        for col in 0..frame.width {
-            values.push(if (7..10).contains(&i) {
-                frame.position(row, col)[i - 7]
-            } else {
-                record_fields(frame.at(row, col))[i]
-            });
-        }
+/// Field `i` of [`FIELDS`] of pixel `k` (in reading order, the top row first):
+/// the `i`-th float of [`pixel_fields`], the primary ray computed only for the
+/// position's.
+fn field_value(frame: &Frame, i: usize, k: usize) -> f32 {
+    if (7..10).contains(&i) {
+        let width = frame.width as usize;
+        frame.position((k / width) as u32, (k % width) as u32)[i - 7]
+    } else {
+        record_fields(&frame.pixels[k])[i]
     }
-    values
 }
 
 /// The contents of `folder/pixels.js` for `frame`: every field the stage
@@ -127,24 +123,33 @@ fn field_values(frame: &Frame, i: usize) -> Vec<f32> {
 /// parallel: the same bytes whatever the number of threads).
 pub fn pixels_js(folder: &str, frame: &Frame) -> String {
     use rayon::prelude::*;
+    // Each field is packed straight from the records, and the text is put
+    // together field by field, each dropped once copied: at 1920 × 1080 a
+    // field's float32s are 8 MB, and `raystep stages` keeps its peak memory
+    // near the frame's own.
+    let n = frame.pixels.len();
     let fields: Vec<(&str, String)> = FIELDS
         .par_iter()
         .enumerate()
         .filter(|(_, (_, buffer))| frame.has(*buffer))
-        .map(|(i, (name, _))| (*name, pack_field(&field_values(frame, i))))
+        .map(|(i, (name, _))| (*name, pack_with(n, |k| field_value(frame, i, k))))
         .collect();
-    let mut js =
-        String::from("// The numbers of every pixel, for index.html. Written by raystep stages.\n");
+    let packed: usize = fields
+        .iter()
+        .map(|(name, data)| name.len() + data.len() + 32)
+        .sum();
+    let mut js = String::with_capacity(packed + 256);
+    js.push_str("// The numbers of every pixel, for index.html. Written by raystep stages.\n");
     let folder = serde_json::to_string(folder).expect("a string is valid JSON");
     js.push_str(&format!(
         "raystepPixels.load({folder}, {{\"width\": {}, \"height\": {}, \"fields\": [",
         frame.width, frame.height
     ));
-    for (i, (name, data)) in fields.iter().enumerate() {
-        let sep = if i == 0 { "\n" } else { ",\n" };
-        js.push_str(&format!(
-            "{sep}{{\"name\": \"{name}\", \"data\": \"{data}\"}}"
-        ));
+    for (i, (name, data)) in fields.into_iter().enumerate() {
+        js.push_str(if i == 0 { "\n" } else { ",\n" });
+        js.push_str(&format!("{{\"name\": \"{name}\", \"data\": \""));
+        js.push_str(&data);
+        js.push_str("\"}");
     }
     js.push_str("\n]});\n");
     js
@@ -166,11 +171,15 @@ pub fn pixels_js(folder: &str, frame: &Frame) -> String {
 ///
 /// The page undoes the three in reverse (`assets/page/page.js`, `unpack`).
 pub fn pack_field(values: &[f32]) -> String {
-    let n = values.len();
+    pack_with(values.len(), |i| values[i])
+}
+
+/// [`pack_field`] of the `n` values `value(0)`, `value(1)`, …
+fn pack_with(n: usize, value: impl Fn(usize) -> f32) -> String {
     let mut planes = vec![0u8; 4 * n];
     let mut before = 0u32;
-    for (i, v) in values.iter().enumerate() {
-        let bits = v.to_bits();
+    for i in 0..n {
+        let bits = value(i).to_bits();
         let difference = bits.wrapping_sub(before).to_le_bytes();
         before = bits;
         for (plane, byte) in difference.into_iter().enumerate() {
@@ -178,6 +187,7 @@ pub fn pack_field(values: &[f32]) -> String {
         }
     }
     let zlib = miniz_oxide::deflate::compress_to_vec_zlib(&planes, ZLIB_LEVEL);
+    drop(planes);
     let mut out = String::with_capacity(zlib.len().div_ceil(3) * 4);
     base64_into(&mut out, &zlib);
     out
