@@ -2,7 +2,8 @@
 //! groups of boxes, so that a ray tests only the spheres whose boxes it crosses.
 //!
 //! **Build.** Every sphere gets its axis-aligned box. A node's spheres are
-//! sorted by their box centres into `BINS` bins along each axis and split
+//! sorted by their box centres into `BINS` bins (fewer near the leaves) along the
+//! axis where the centres spread most and split
 //! between the two bins where the surface area heuristic is least: the sum over
 //! both sides of the side's box area (how likely a ray that crosses the node is to
 //! cross it) times its number of spheres. Each side is split again, until at most
@@ -112,6 +113,9 @@ struct Item {
     min: glam::Vec3A,
     max: glam::Vec3A,
     index: u32,
+    /// The bin [`divide`] put it in last (kept in what would be padding, so
+    /// that the partition after the binning need not compute it again).
+    bin: u32,
 }
 
 impl Item {
@@ -125,6 +129,14 @@ impl Item {
 /// Bins of the surface area heuristic ([`divide`]).
 const BINS: usize = 16;
 
+/// Nodes of at most this many spheres are split over [`FEW_BINS`] bins: near the
+/// leaves a split has few places to go, and setting up and sweeping sixteen bins
+/// would cost more than sorting the spheres into them.
+const FEW_FROM: usize = 32;
+
+/// Bins of the surface area heuristic for nodes of at most [`FEW_FROM`] spheres.
+const FEW_BINS: usize = 8;
+
 /// From this depth on, a node is split at the median, whatever the surface area
 /// heuristic would choose: the median keeps the rest of the tree within
 /// log₂(n / [`LEAF`]) + 1 < 32 more levels for any n below 2³², so that no walk
@@ -136,10 +148,10 @@ const SAH_DEPTH: usize = 32;
 /// ones on the thread that reached them. The tree is the same either way.
 const PARALLEL_FROM: usize = 8192;
 
-/// Which of the [`BINS`] bins the centre coordinate `c` falls in.
+/// Which of `N` bins the centre coordinate `c` falls in.
 #[inline]
-fn bin_of(c: f32, low: f32, scale: f32) -> usize {
-    (((c - low) * scale) as usize).min(BINS - 1)
+fn bin_of<const N: usize>(c: f32, low: f32, scale: f32) -> usize {
+    (((c - low) * scale) as usize).min(N - 1)
 }
 
 /// A box, growing as spheres are added.
@@ -212,6 +224,7 @@ impl Bvh {
                         min: min.to_array().map(below).into(),
                         max: max.to_array().map(above).into(),
                         index: i as u32,
+                        bin: 0,
                     });
                 }
                 _ => loose.push(i as u32),
@@ -530,7 +543,8 @@ fn grow(
 /// children's spans.
 ///
 /// The split is by the surface area heuristic over [`BINS`] bins of the box
-/// centres along the axis where they spread most: the boundary between two bins
+/// centres ([`FEW_BINS`] for nodes of at most [`FEW_FROM`] spheres) along the
+/// axis where they spread most: the boundary between two bins
 /// that minimises each side's box area times its number of spheres (the lowest
 /// such). From depth [`SAH_DEPTH`] on, or where every centre is the same, it is
 /// at the median along that axis instead.
@@ -543,7 +557,6 @@ fn divide(items: &mut [Item], span: &Span, depth: usize) -> (usize, [Span; 2]) {
     } else {
         2
     };
-    let low = span.centres.min[axis];
     let scale = BINS as f32 / spread[axis];
     if depth >= SAH_DEPTH || !(spread[axis] > 0.0 && scale.is_finite()) {
         let middle = items.len() / 2;
@@ -555,24 +568,43 @@ fn divide(items: &mut [Item], span: &Span, depth: usize) -> (usize, [Span; 2]) {
         let (left, right) = items.split_at(middle);
         return (middle, [Span::of(left), Span::of(right)]);
     }
-    let mut bins = [Span::EMPTY; BINS];
-    let mut counts = [0u32; BINS];
-    for i in items.iter() {
-        let k = bin_of(i.centre()[axis], low, scale);
+    let low = span.centres.min[axis];
+    if items.len() <= FEW_FROM {
+        let scale = FEW_BINS as f32 / spread[axis];
+        binned::<FEW_BINS>(items, axis, low, scale)
+    } else {
+        binned::<BINS>(items, axis, low, scale)
+    }
+}
+
+/// The split of [`divide`] over `N` bins along `axis`, the first from `low` on,
+/// `scale` of them to a unit of length.
+#[inline(always)]
+fn binned<const N: usize>(
+    items: &mut [Item],
+    axis: usize,
+    low: f32,
+    scale: f32,
+) -> (usize, [Span; 2]) {
+    let mut bins = [Span::EMPTY; N];
+    let mut counts = [0u32; N];
+    for i in items.iter_mut() {
+        let k = bin_of::<N>(i.centre()[axis], low, scale);
+        i.bin = k as u32;
         counts[k] += 1;
         bins[k].add(i);
     }
     // The area of the bins from k on, for each k.
-    let mut right_area = [0.0; BINS];
+    let mut right_area = [0.0; N];
     let mut right = Bounds::EMPTY;
-    for k in (1..BINS).rev() {
+    for k in (1..N).rev() {
         right.join(&bins[k].bounds);
         right_area[k] = right.half_area();
     }
     let mut best = (f64::INFINITY, 0);
     let mut left = Bounds::EMPTY;
     let mut on_left = 0usize;
-    for k in 0..BINS - 1 {
+    for k in 0..N - 1 {
         left.join(&bins[k].bounds);
         on_left += counts[k] as usize;
         let on_right = items.len() - on_left;
@@ -593,7 +625,7 @@ fn divide(items: &mut [Item], span: &Span, depth: usize) -> (usize, [Span; 2]) {
     }
     let (mut i, mut j) = (0, items.len());
     while i < j {
-        if bin_of(items[i].centre()[axis], low, scale) <= bin {
+        if items[i].bin as usize <= bin {
             i += 1;
         } else {
             j -= 1;

@@ -139,8 +139,9 @@ impl Bvh {
         loop {
             let n = self.nodes[node];
             if n.count > 0 {
-                for k in n.first as usize..(n.first + n.count) as usize {
-                    search.test_sphere(self.items[k] as usize, &self.balls[k]);
+                let run = n.first as usize..(n.first + n.count) as usize;
+                for (&i, ball) in self.items[run.clone()].iter().zip(&self.balls[run]) {
+                    search.test_sphere(i as usize, ball);
                 }
                 now = limits(search);
                 if now.0 == 0 {
