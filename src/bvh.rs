@@ -2,7 +2,8 @@
 //! groups of boxes, so that a ray tests only the spheres whose boxes it crosses.
 //!
 //! **Build.** Every sphere gets its axis-aligned box. A node's spheres are
-//! sorted by their box centres into `BINS` bins along each axis and split
+//! sorted by their box centres into `BINS` bins (fewer near the leaves) along the
+//! axis where the centres spread most and split
 //! between the two bins where the surface area heuristic is least: the sum over
 //! both sides of the side's box area (how likely a ray that crosses the node is to
 //! cross it) times its number of spheres. Each side is split again, until at most
@@ -44,6 +45,7 @@ use crate::real::{Real, Vector};
 use crate::scene::{consider, Hit, Object, Role, Shape};
 use crate::sphere::Method;
 use crate::Vec3;
+use rayon::prelude::*;
 
 /// Most spheres in a leaf.
 pub const LEAF: usize = 4;
@@ -112,6 +114,9 @@ struct Item {
     min: glam::Vec3A,
     max: glam::Vec3A,
     index: u32,
+    /// The bin [`divide`] put it in last (kept in what would be padding, so
+    /// that the partition after the binning need not compute it again).
+    bin: u32,
 }
 
 impl Item {
@@ -125,6 +130,14 @@ impl Item {
 /// Bins of the surface area heuristic ([`divide`]).
 const BINS: usize = 16;
 
+/// Nodes of at most this many spheres are split over [`FEW_BINS`] bins: near the
+/// leaves a split has few places to go, and setting up and sweeping sixteen bins
+/// would cost more than sorting the spheres into them.
+const FEW_FROM: usize = 32;
+
+/// Bins of the surface area heuristic for nodes of at most [`FEW_FROM`] spheres.
+const FEW_BINS: usize = 8;
+
 /// From this depth on, a node is split at the median, whatever the surface area
 /// heuristic would choose: the median keeps the rest of the tree within
 /// log₂(n / [`LEAF`]) + 1 < 32 more levels for any n below 2³², so that no walk
@@ -136,10 +149,10 @@ const SAH_DEPTH: usize = 32;
 /// ones on the thread that reached them. The tree is the same either way.
 const PARALLEL_FROM: usize = 8192;
 
-/// Which of the [`BINS`] bins the centre coordinate `c` falls in.
+/// Which of `N` bins the centre coordinate `c` falls in.
 #[inline]
-fn bin_of(c: f32, low: f32, scale: f32) -> usize {
-    (((c - low) * scale) as usize).min(BINS - 1)
+fn bin_of<const N: usize>(c: f32, low: f32, scale: f32) -> usize {
+    (((c - low) * scale) as usize).min(N - 1)
 }
 
 /// A box, growing as spheres are added.
@@ -212,6 +225,7 @@ impl Bvh {
                         min: min.to_array().map(below).into(),
                         max: max.to_array().map(above).into(),
                         index: i as u32,
+                        bin: 0,
                     });
                 }
                 _ => loose.push(i as u32),
@@ -232,9 +246,9 @@ impl Bvh {
         // is its slice of the partitioned list.
         Bvh {
             nodes,
-            items: items.iter().map(|i| i.index).collect(),
+            items: items.par_iter().map(|i| i.index).collect(),
             balls: items
-                .iter()
+                .par_iter()
                 .map(|i| match objects[i.index as usize].shape {
                     Shape::Sphere(s) => {
                         let c = s.center.to_f64();
@@ -530,7 +544,8 @@ fn grow(
 /// children's spans.
 ///
 /// The split is by the surface area heuristic over [`BINS`] bins of the box
-/// centres along the axis where they spread most: the boundary between two bins
+/// centres ([`FEW_BINS`] for nodes of at most [`FEW_FROM`] spheres) along the
+/// axis where they spread most: the boundary between two bins
 /// that minimises each side's box area times its number of spheres (the lowest
 /// such). From depth [`SAH_DEPTH`] on, or where every centre is the same, it is
 /// at the median along that axis instead.
@@ -543,7 +558,6 @@ fn divide(items: &mut [Item], span: &Span, depth: usize) -> (usize, [Span; 2]) {
     } else {
         2
     };
-    let low = span.centres.min[axis];
     let scale = BINS as f32 / spread[axis];
     if depth >= SAH_DEPTH || !(spread[axis] > 0.0 && scale.is_finite()) {
         let middle = items.len() / 2;
@@ -555,24 +569,43 @@ fn divide(items: &mut [Item], span: &Span, depth: usize) -> (usize, [Span; 2]) {
         let (left, right) = items.split_at(middle);
         return (middle, [Span::of(left), Span::of(right)]);
     }
-    let mut bins = [Span::EMPTY; BINS];
-    let mut counts = [0u32; BINS];
-    for i in items.iter() {
-        let k = bin_of(i.centre()[axis], low, scale);
+    let low = span.centres.min[axis];
+    if items.len() <= FEW_FROM {
+        let scale = FEW_BINS as f32 / spread[axis];
+        binned::<FEW_BINS>(items, axis, low, scale)
+    } else {
+        binned::<BINS>(items, axis, low, scale)
+    }
+}
+
+/// The split of [`divide`] over `N` bins along `axis`, the first from `low` on,
+/// `scale` of them to a unit of length.
+#[inline(always)]
+fn binned<const N: usize>(
+    items: &mut [Item],
+    axis: usize,
+    low: f32,
+    scale: f32,
+) -> (usize, [Span; 2]) {
+    let mut bins = [Span::EMPTY; N];
+    let mut counts = [0u32; N];
+    for i in items.iter_mut() {
+        let k = bin_of::<N>(i.centre()[axis], low, scale);
+        i.bin = k as u32;
         counts[k] += 1;
         bins[k].add(i);
     }
     // The area of the bins from k on, for each k.
-    let mut right_area = [0.0; BINS];
+    let mut right_area = [0.0; N];
     let mut right = Bounds::EMPTY;
-    for k in (1..BINS).rev() {
+    for k in (1..N).rev() {
         right.join(&bins[k].bounds);
         right_area[k] = right.half_area();
     }
     let mut best = (f64::INFINITY, 0);
     let mut left = Bounds::EMPTY;
     let mut on_left = 0usize;
-    for k in 0..BINS - 1 {
+    for k in 0..N - 1 {
         left.join(&bins[k].bounds);
         on_left += counts[k] as usize;
         let on_right = items.len() - on_left;
@@ -593,7 +626,7 @@ fn divide(items: &mut [Item], span: &Span, depth: usize) -> (usize, [Span; 2]) {
     }
     let (mut i, mut j) = (0, items.len());
     while i < j {
-        if bin_of(items[i].centre()[axis], low, scale) <= bin {
+        if items[i].bin as usize <= bin {
             i += 1;
         } else {
             j -= 1;
@@ -604,18 +637,19 @@ fn divide(items: &mut [Item], span: &Span, depth: usize) -> (usize, [Span; 2]) {
 }
 
 /// The largest float32 not above `x`.
+///
+/// Whether `x` rounded to float32 comes out above or below it is as good as
+/// random, so the step down is made whatever, and picked by a mask, not a
+/// branch that the processor would mispredict half the time.
 pub(crate) fn below(x: f64) -> f32 {
     let r = x as f32;
-    if f64::from(r) <= x {
-        r
-    } else if r > 0.0 {
-        // One step down (what `f32::next_down` does, from Rust 1.86 on).
-        f32::from_bits(r.to_bits() - 1)
-    } else if r < 0.0 {
-        f32::from_bits(r.to_bits() + 1)
-    } else {
-        -f32::from_bits(1)
-    }
+    // One step down (what `f32::next_down` does, from Rust 1.86 on): of the
+    // bits, one less above zero and one more below it; from zero, to the
+    // smallest negative subnormal (one more than the bits of -0).
+    let s = if r == 0.0 { -0.0f32 } else { r }.to_bits() as i32;
+    let down = s.wrapping_sub((s >> 31).wrapping_mul(2).wrapping_add(1)) as u32;
+    let keep = u32::from(f64::from(r) <= x).wrapping_neg();
+    f32::from_bits((r.to_bits() & keep) | (down & !keep))
 }
 
 /// The smallest float32 not below `x`.
@@ -785,6 +819,58 @@ mod tests {
         // From a point far out on the floor, larger in proportion.
         let far = floored.margin(u, Vec3::new(0.0, 0.0, 1000.0));
         assert!(far > 50.0 * near, "{far} {near}");
+    }
+
+    /// `below` as it was written with branches: the masked one gives the same
+    /// bits for every finite or infinite `x`, so the boxes (and the tree) are
+    /// the same.
+    fn below_by_branches(x: f64) -> f32 {
+        let r = x as f32;
+        if f64::from(r) <= x {
+            r
+        } else if r > 0.0 {
+            f32::from_bits(r.to_bits() - 1)
+        } else if r < 0.0 {
+            f32::from_bits(r.to_bits() + 1)
+        } else {
+            -f32::from_bits(1)
+        }
+    }
+
+    #[test]
+    fn the_masked_step_down_is_the_branching_one() {
+        let mut special = vec![
+            0.0,
+            -0.0,
+            1e-50,
+            -1e-50,
+            1e-45,
+            -1e-45,
+            f64::from(f32::MAX),
+            -f64::from(f32::MAX),
+            1e39,
+            -1e39,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MAX,
+            f64::MIN,
+        ];
+        // Many more, spread over every exponent: bit patterns from a fixed
+        // sequence, and their neighbours among float32s.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let x = f64::from_bits(state);
+            if x.is_finite() {
+                special.push(x);
+                special.push(f64::from(x as f32));
+            }
+        }
+        for x in special {
+            assert_eq!(below(x).to_bits(), below_by_branches(x).to_bits(), "{x:e}");
+        }
     }
 
     #[test]

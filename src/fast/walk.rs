@@ -139,13 +139,14 @@ impl Bvh {
         loop {
             let n = self.nodes[node];
             if n.count > 0 {
-                for k in n.first as usize..(n.first + n.count) as usize {
-                    search.test_sphere(self.items[k] as usize, &self.balls[k]);
+                let run = n.first as usize..(n.first + n.count) as usize;
+                for (&i, ball) in self.items[run.clone()].iter().zip(&self.balls[run]) {
+                    search.test_sphere(i as usize, ball);
+                    if search.active() == 0 {
+                        return; // no lane is searching any more (all blocked)
+                    }
                 }
                 now = limits(search);
-                if now.0 == 0 {
-                    return; // no lane is searching any more (all blocked)
-                }
             } else {
                 let (a, b) = (node + 1, n.first as usize);
                 let (ta, ma) = enters(a, now);
