@@ -85,8 +85,34 @@ pub struct Bvh {
 }
 
 /// How far outside a sphere its intersection test may report a hit, in units of
-/// `u·(|O| + S)` (see [`Bvh::margin`]): a generous multiple of the few roundings
-/// of `m = C − O` and of `‖h·d − m‖²` that decide a hit.
+/// `u·(|O| + S)` (see [`Bvh::margin`]).
+///
+/// The bound, as [`crate::shade::shadow::step_out`]'s is derived (Higham's
+/// model, `|δ| ≤ u` per operation, first order in `u`), for the stable test's
+/// `Δ/4 = r² − ‖h·d − m‖²` (the naive method builds no tree):
+///
+/// 1. `m = C − O` is rounded per component: `u·‖m‖`;
+/// 2. `h = ⟨d, m⟩` is off by `γ_3·‖m‖`, and `h·d − m` rounds its product and
+///    its difference: with 1., the closest-point vector is within `8u·‖m‖` of
+///    the exact one (the direction's length, `1 ± 4u`, moves it along `d`
+///    only, which is of second order in its length);
+/// 3. `‖h·d − m‖²` (`γ_3`) and `r²` (`u`) move the distance compared with `r`
+///    by `1.5u·r` and `0.5u·r`.
+///
+/// So a reported hit passes within `r + u·(8·‖m‖ + 2r)` of the centre, and with
+/// `‖m‖ ≤ √3·(|O| + S)` and `r ≤ S` that is within `(8√3 + 2)·u·(|O| + S)`,
+/// about `16u·(|O| + S)`, of the sphere's box. The same margin moves every box's
+/// entry at least that much closer along the ray, which covers the error of the
+/// hit's distance (`c/q`: about `4u·‖m‖`) when a box is skipped for a nearer
+/// hit. The boxes' own rounding is apart: computed in float64 and rounded
+/// outwards, and padded for the packets' float32 test (`FAST_PAD`).
+///
+/// 64 is four times that first-order 16, kept as it was: the factor covers the
+/// second-order terms with room to spare, a wider box changes no pixel, and
+/// the width it adds (64u of `|O| + S`: 7.1e-15 of it in float64, 3.8e-6
+/// in float32) is far below the boxes' own; too narrow a margin would change
+/// pixels (the fast engine's bit-identity test, `tests/speed.rs`, renders every
+/// scene both ways).
 pub const MARGIN: f64 = 64.0;
 
 /// A ray as the slab test sees it: its origin moved by the ray's margin towards

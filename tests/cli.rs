@@ -347,7 +347,7 @@ fn chart_writes_its_csv_svg_and_png() {
     );
     assert!(out.status.success(), "{}", text(&out.stderr));
     let csv = std::fs::read_to_string(dir.path().join("c/chart.csv")).unwrap();
-    assert_eq!(csv.lines().count(), 16, "a header and 15 settings: {csv}");
+    assert_eq!(csv.lines().count(), 18, "a header and 17 settings: {csv}");
     assert_eq!(png_size(&dir.path().join("c/chart.png")), (960, 640));
     assert!(std::fs::read_to_string(dir.path().join("c/chart.svg"))
         .unwrap()

@@ -1357,7 +1357,7 @@ fn chapter_10_exercise_3_early_stop_saves_two_fifths_of_the_corridors_rays() {
 }
 
 #[test]
-fn chapter_10_exercise_4_four_samples_are_the_best_picture_in_60_ms() {
+fn chapter_10_exercise_4_four_samples_are_the_best_picture_in_70_ms() {
     // The committed chart's numbers: setting, median ms, error in levels.
     let csv = file("chapters/charts/chart.csv");
     let mut rows: Vec<(String, f64, f64)> = Vec::new();
@@ -1369,7 +1369,7 @@ fn chapter_10_exercise_4_four_samples_are_the_best_picture_in_60_ms() {
     }
     let best = rows
         .iter()
-        .filter(|r| r.1 <= 60.0)
+        .filter(|r| r.1 <= 70.0)
         .min_by(|a, b| a.2.total_cmp(&b.2))
         .unwrap();
     assert_eq!(best.0, "spp 4");
@@ -1378,8 +1378,8 @@ fn chapter_10_exercise_4_four_samples_are_the_best_picture_in_60_ms() {
         "4 samples per pixel: {:.0} ms for an error of {:.1} levels",
         best.1, best.2
     )));
-    // "Every other setting under 60 ms has about twice that error or more."
-    for r in rows.iter().filter(|r| r.1 <= 60.0 && r.0 != "spp 4") {
+    // "Every other setting under 70 ms has about twice that error or more."
+    for r in rows.iter().filter(|r| r.1 <= 70.0 && r.0 != "spp 4") {
         assert!(r.2 > 1.75 * best.2, "{r:?}");
     }
 }

@@ -174,7 +174,11 @@ pub fn auto_step(u: f64, radius: f64, on_surface: crate::Vec3) -> f64 {
 /// How far round the terminator a shadow ray that starts the `auto` step `h` above
 /// a sphere of radius `radius` passes over it: it enters the sphere at `|L·N| = s`
 /// only if `(r + h)·√(1 − s²) ≤ r`, so for `s` below about `√(2h/r)` it clears it.
-/// In float32 that is at least `√(20u)` = 1.1e-3.
+/// In float32 that is at least `√(20u)` = 1.1e-3. (This is the nominal step's
+/// band, which the float32 warnings quote; the band `raystep accuracy` judges
+/// with, `tools::accuracy::terminator_band`, takes the height the step's origin
+/// actually has, the step plus the point's error, and adds the `8u` by which
+/// the next test's `Δ/4` may be off.)
 pub fn pass_over(u: f64, radius: f64, on_surface: crate::Vec3) -> f64 {
     (2.0 * auto_step(u, radius, on_surface) / radius).sqrt()
 }

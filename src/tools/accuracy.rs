@@ -14,7 +14,7 @@ use crate::ray::Ray;
 use crate::real::{Precision, Real, Vector};
 use crate::render::{Settings, Tracer};
 use crate::scene::{Object, Scene, Shape};
-use crate::shade::shadow::{auto_step, pass_over, step_off, Offset};
+use crate::shade::shadow::{auto_step, step_off, Offset};
 use crate::sphere::{Method, Sphere};
 use crate::stages::Stages;
 use crate::Vec3;
@@ -137,14 +137,31 @@ pub fn silhouette_band(u: f64, origin: Vec3, s: &Sphere) -> f64 {
     relative.max(SILHOUETTE_UNITS * u * sizes)
 }
 
-/// The terminator band at a point `on_surface` of a sphere of radius `radius`,
-/// for a precision of unit roundoff `u`: the larger of [`TERMINATOR_BAND`] and
-/// the band in which a shadow ray started the `auto` step `h` out passes over
-/// its own sphere ([`pass_over`], about `√(2h/r)`), which no offset that keeps
-/// origins outside can undercut by more than a small factor. In float64 it is
-/// [`TERMINATOR_BAND`] for any sphere within 1e9 radii of the origin.
-pub fn terminator_band(u: f64, radius: f64, on_surface: Vec3) -> f64 {
-    TERMINATOR_BAND.max(pass_over(u, radius, on_surface))
+/// Unit roundoffs of `r²` by which the stable test's `Δ/4 = r² − ‖h·d − m‖²`
+/// may be off for a ray that grazes its own sphere: `m = C − O` (2u of `‖m‖²`),
+/// `h·d − m` (2u), the sum of squares (γ_3) and `r²` (u), to first order.
+pub const GRAZE_UNITS: f64 = 8.0;
+
+/// The terminator band of a sphere of radius `radius` at a point whose `auto`
+/// shadow ray starts `height` above the sphere (the step `h` of
+/// [`crate::shade::shadow::step_out`] plus the point's own error, which the
+/// judge measures), for a precision of unit roundoff `u`: the larger of
+/// [`TERMINATOR_BAND`] and `√(2·height/r + 8u)`.
+///
+/// Why. A shadow ray from `height` above the sphere into its dark side at
+/// `|L·N| = s` passes within `(r + height)·√(1 − s²)` of the centre: it misses
+/// the sphere, and the dark-side point reads lit, when that is more than `r`,
+/// that is when `s² < 2·height/r` (to first order). The test that decides it
+/// computes `Δ/4` within [`GRAZE_UNITS`]`·u·r²`, so it may answer either way
+/// for `s²` within `8u` of that. No offset that keeps origins outside does
+/// better: `height` is at least what rounding can put the point off the sphere
+/// by (a few `u·r`), so in float32 the band is more than 1e-3 on every sphere
+/// (`√(2·4.5u + 8u)` = 1.0e-3 at the very least, about 1.3e-3 on the fake
+/// floor); in float64 it is [`TERMINATOR_BAND`] for any sphere within 1e9
+/// radii of the origin. (The judge adds the angle by which rounding moved that
+/// origin along the surface, seen from the centre, beside the point it judges.)
+pub fn terminator_band(u: f64, radius: f64, height: f64) -> f64 {
+    TERMINATOR_BAND.max((2.0 * height / radius + GRAZE_UNITS * u).sqrt())
 }
 
 /// What one configuration gets wrong on one scene.
@@ -191,6 +208,11 @@ pub struct Measure {
     pub wrong_shadow: f64,
     /// Wrong shadow verdicts, counted (the numerator of `wrong_shadow`).
     pub wrong_shadows: usize,
+    /// Wrong shadow verdicts where |L·N| is at least [`TERMINATOR_BAND`] (1e-3),
+    /// whatever the terminator band of the precision at that point: in float32
+    /// these include the dark-side points within the band the bound's own step
+    /// makes ([`terminator_band`]), which `wrong_shadows` does not count.
+    pub wrong_shadows_1e3: usize,
     /// The largest |L·N| at a wrong shadow verdict (0 if there is none): how far
     /// from the terminator the failures reach.
     pub worst_facing: f64,
@@ -276,6 +298,7 @@ fn measure_in<T: Real>(scene: &Scene, settings: &Settings) -> Measure {
         stuck: 0.0,
         wrong_shadow: 0.0,
         wrong_shadows: 0,
+        wrong_shadows_1e3: 0,
         worst_facing: 0.0,
     };
     let u = T::UNIT_ROUNDOFF.to_f64();
@@ -348,13 +371,31 @@ fn measure_in<T: Real>(scene: &Scene, settings: &Settings) -> Measure {
             }
             // Is the shadow verdict the reference's?
             let facing = first.normal;
-            if let Some((lit, l_dot_n)) =
-                reference_lit(&reference, first.object, point.to_f64(), facing, light, u)
-            {
-                shadow_judged += 1;
+            // Where the bound's own shadow ray starts, whatever the offset under
+            // test: the terminator band is where that ray passes over its sphere.
+            let bound_origin = match settings.offset {
+                Offset::Auto => shifted,
+                _ => step_off(point, T::Vec3::of(first.normal), object, Offset::Auto),
+            }
+            .to_f64();
+            if let Some((lit, l_dot_n, band)) = reference_lit(
+                &reference,
+                first.object,
+                point.to_f64(),
+                facing,
+                light,
+                u,
+                bound_origin,
+            ) {
                 if lit != first.lit {
-                    wrong += 1;
-                    m.worst_facing = m.worst_facing.max(l_dot_n.abs());
+                    m.wrong_shadows_1e3 += 1;
+                }
+                if l_dot_n.abs() >= band {
+                    shadow_judged += 1;
+                    if lit != first.lit {
+                        wrong += 1;
+                        m.worst_facing = m.worst_facing.max(l_dot_n.abs());
+                    }
                 }
             }
         }
@@ -529,7 +570,8 @@ fn reference_lit(
     facing: Vec3,
     light: Vec3,
     u: f64,
-) -> Option<(bool, f64)> {
+    bound_origin: Vec3,
+) -> Option<(bool, f64, f64)> {
     let object = &objects[index];
     let on_surface = object.project(p);
     let normal = match object.shape {
@@ -541,15 +583,24 @@ fn reference_lit(
     let to_light = (light - on_surface).normalize();
     let facing = to_light.dot(normal);
     let (band, size) = match object.shape {
-        Shape::Sphere(s) => (terminator_band(u, s.radius, on_surface), s.radius),
+        Shape::Sphere(s) => {
+            // The bound's origin, from the centre: its height above the sphere, and
+            // how far rounding moved it along the surface from the point judged
+            // (which turns the normal it sees by that over the radius).
+            let from_centre = bound_origin - s.center;
+            let height = (from_centre.length() - s.radius).abs();
+            let aside = (from_centre - normal * from_centre.dot(normal)).length();
+            let band = terminator_band(u, s.radius, height) + aside / s.radius;
+            (band, s.radius)
+        }
         Shape::Plane(pl) => (TERMINATOR_BAND, on_surface.distance(pl.point)),
     };
-    if facing.abs() < band {
+    if facing.abs() < TERMINATOR_BAND {
         return None;
     }
     // A sphere shadows its own far side; a plane lights both of its faces the same.
     if facing < 0.0 && matches!(object.shape, Shape::Sphere(_)) {
-        return Some((false, facing));
+        return Some((false, facing, band));
     }
     let slack = auto_step(u, size, on_surface);
     let ray = Ray {
@@ -566,13 +617,13 @@ fn reference_lit(
             lit = false;
         }
     }
-    Some((lit, facing))
+    Some((lit, facing, band))
 }
 
 /// The header line of `raystep accuracy`'s table.
 pub fn table_header() -> String {
     format!(
-        "{:<17} {:<4} {:<6} {:<10} {:>7} {:>7} {:>10} {:>9} {:>7} {:>7} {:>8} {}",
+        "{:<17} {:<4} {:<6} {:<10} {:>7} {:>7} {:>10} {:>9} {:>7} {:>7} {:>8} {:>6} {:>6} {}",
         "case",
         "prec",
         "method",
@@ -584,6 +635,8 @@ pub fn table_header() -> String {
         "stuck%",
         "shadow%",
         "max|L·N|",
+        "wrong",
+        ">1e-3",
         "limit"
     )
 }
@@ -591,7 +644,7 @@ pub fn table_header() -> String {
 /// One line of `raystep accuracy`'s table.
 pub fn table_row(m: &Measure) -> String {
     format!(
-        "{:<17} {:<4} {:<6} {:<10} {:>7} {:>7} {:>10.1e} {:>9.1} {:>7.2} {:>7.2} {:>8.1e} {}",
+        "{:<17} {:<4} {:<6} {:<10} {:>7} {:>7} {:>10.1e} {:>9.1} {:>7.2} {:>7.2} {:>8.1e} {:>6} {:>6} {}",
         m.case,
         m.precision,
         m.method,
@@ -603,6 +656,8 @@ pub fn table_row(m: &Measure) -> String {
         100.0 * m.stuck,
         100.0 * m.wrong_shadow,
         m.worst_facing,
+        m.wrong_shadows,
+        m.wrong_shadows_1e3,
         m.limit
     )
 }

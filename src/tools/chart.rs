@@ -105,6 +105,12 @@ fn configs(max_depth: u32) -> Vec<Config> {
         with("f32", &|s| s.precision = Precision::F32),
         with("naive", &|s| s.method = Method::Naive),
         with("fixed:1e-5", &|s| s.offset = Offset::TUTORIAL),
+        // The scene-sized step the bound replaced: what the bound costs.
+        with("offset scene", &|s| s.offset = Offset::Scene),
+        with("f32, offset scene", &|s| {
+            s.precision = Precision::F32;
+            s.offset = Offset::Scene;
+        }),
         with("accel off", &|s| s.accel = Accel::Off),
         with("book engine", &|s| s.engine = Engine::Book),
         with("early stop off", &|s| s.early_stop = false),
