@@ -840,14 +840,32 @@ pub fn png_bytes_as(frame: &Frame, buffer: Buffer, png: PngEncoding) -> Vec<u8> 
     encode_png(frame, buffer, png, &visualise_as(frame, buffer, png))
 }
 
-/// The PNG file of `buffer`'s picture `rgb` (see [`png_bytes_as`]).
+/// The PNG file of `buffer`'s picture `rgb` (see [`png_bytes_as`]): encoded as
+/// the files of a render are, by a stream of [`PNG_CHUNK`]-sized `IDAT` chunks,
+/// so that these bytes are the file's (the studio's `/api/render` promises it).
 fn encode_png(frame: &Frame, buffer: Buffer, png: PngEncoding, rgb: &[u8]) -> Vec<u8> {
-    let mut bytes = Vec::new();
-    png_encoder(frame, buffer, png, &mut bytes)
+    // The stream owns what it writes to: a buffer it shares with this function.
+    #[derive(Clone, Default)]
+    struct Shared(std::rc::Rc<std::cell::RefCell<Vec<u8>>>);
+    impl Write for Shared {
+        fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+            self.0.borrow_mut().extend_from_slice(bytes);
+            Ok(bytes.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+    let bytes = Shared::default();
+    png_encoder(frame, buffer, png, bytes.clone())
         .write_header()
-        .and_then(|mut writer| writer.write_image_data(rgb))
+        .and_then(|writer| writer.into_stream_writer_with_size(PNG_CHUNK))
+        .and_then(|mut stream| {
+            stream.write_all(rgb)?;
+            stream.finish()
+        })
         .expect("encoding a PNG into memory cannot fail");
-    bytes
+    bytes.0.take()
 }
 
 /// The PNG encoder of `buffer`'s picture, writing to `out`: 8-bit RGB, fast
