@@ -206,7 +206,7 @@ impl Pending {
     /// render) will be removed by the commit. Returns the files' final paths.
     ///
     /// Every file is streamed from the frame in one pass over its records (see
-    /// [`write_files`]), so no copy of the buffers is made: at 1920 × 1080 the
+    /// `write_files`), so no copy of the buffers is made: at 1920 × 1080 the
     /// frame's 108 MB is most of what the whole render holds in memory.
     pub fn frame(&mut self, frame: &Frame, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         let buffers: Vec<Buffer> = frame.buffers().collect();
@@ -818,7 +818,7 @@ impl PngEncoding {
 /// The sRGB transfer function of IEC 61966-2-1, exact and piecewise: linear
 /// light `v` in [0, 1] to the value an sRGB display expects, `12.92 v` up to
 /// 0.003 130 8 and `1.055 v^(1/2.4) − 0.055` above (values outside [0, 1] are
-/// clipped later, by [`to_byte`]).
+/// clipped later, by `to_byte`).
 pub fn srgb_encode(v: f32) -> f32 {
     if v <= 0.003_130_8 {
         12.92 * v
@@ -993,7 +993,7 @@ fn exr_sample(
 
 /// Write the EXR file of a frame to `writer`: one float32 channel per number of
 /// every buffer the frame has ([`EXR_CHANNELS`]), in scan lines, compressed as
-/// `compression` says (see [`stream_files`]).
+/// `compression` says (see `stream_files`).
 pub fn exr_to<W: Write + Seek + Send>(
     frame: &Frame,
     writer: W,

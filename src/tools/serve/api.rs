@@ -700,7 +700,7 @@ impl Edits {
 
     /// The scene's TOML `text` with the changes made: each position set in its
     /// table (made if the file has none). The file's own lines are kept, its
-    /// comments too, with each `position = ...` line replaced ([`Edits::in_place`]);
+    /// comments too, with each `position = ...` line replaced (`Edits::in_place`);
     /// when that does not give exactly the values asked for (a position written
     /// over several lines, an inline table), the text is written again from its
     /// values, without the comments.
