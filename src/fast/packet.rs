@@ -62,7 +62,7 @@ use crate::scene::{on_plane, on_sphere};
 use crate::scene::{Light, Object, Scene, Shape};
 use crate::shade::blinn_phong::{factors, whole_exponent, Viewer};
 use crate::shade::reflection::reflect;
-use crate::shade::shadow::{step_out, step_out_by_scene, Offset};
+use crate::shade::shadow::{plane_height, sphere_height, step_out, step_out_by_scene, Offset};
 use crate::sphere::outward_normal;
 use crate::sphere::Method;
 use crate::stages::Stage;
@@ -1005,7 +1005,20 @@ impl<T: Laned> Fast<T> {
                 let u = T::Lanes::splat(T::UNIT_ROUNDOFF);
                 match self.book.offset {
                     Offset::Scene => step_out_by_scene(on_surface, normal, object.magnitude, u),
-                    _ => step_out(on_surface, normal, shape.point, u),
+                    _ => {
+                        let sphere = || sphere_height(point, shape.point, object.radius, u);
+                        let height = if spheres == alive {
+                            sphere()
+                        } else {
+                            let plane = plane_height(on_surface, shape.point, u);
+                            if spheres == 0 {
+                                plane
+                            } else {
+                                T::Lanes::mask(spheres).select(sphere(), plane)
+                            }
+                        };
+                        step_out(on_surface, normal, height)
+                    }
                 }
             }
         }
