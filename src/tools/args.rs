@@ -293,6 +293,14 @@ pub struct StagesArgs {
     /// Output folder; each stage goes into a numbered folder inside it.
     #[arg(long, short = 'o', visible_alias = "output", default_value = "out")]
     pub out: PathBuf,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub files: FileArgs,
+}
+
+/// How the files of a render are encoded (`render`, `stages`).
+#[derive(Args, Debug, Default)]
+pub struct FileArgs {
     /// How beauty.png and the Blinn-Phong terms' pictures store their linear
     /// values: as they are (the tutorial's; they look dark in a viewer), or
     /// through the sRGB transfer function, with an sRGB chunk. buffers.exr is
@@ -332,17 +340,9 @@ pub struct RenderArgs {
     /// Output folder.
     #[arg(long, short = 'o', visible_alias = "output", default_value = "out")]
     pub out: PathBuf,
-    /// How beauty.png and the Blinn-Phong terms' pictures store their linear
-    /// values: as they are (the tutorial's; they look dark in a viewer), or
-    /// through the sRGB transfer function, with an sRGB chunk. buffers.exr is
-    /// always linear.
-    #[arg(long, value_enum, value_name = "srgb|linear", default_value_t = PngEncoding::Linear)]
-    pub png: PngEncoding,
-    /// How buffers.exr is compressed: none (the fastest to write), rle, zips (deflate,
-    /// a scan line per block), zip (deflate, 16 lines) or piz (wavelets); all
-    /// lossless. The README has each one's size and time at 1920 × 1080.
-    #[arg(long, value_enum, value_name = "none|rle|zips|zip|piz", default_value_t = ExrCompression::None)]
-    pub exr_compression: ExrCompression,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub files: FileArgs,
     /// Print one JSON object on standard output saying what was written: the
     /// files and their sizes, the buffers, the timings and the rays traced.
     #[arg(long)]
@@ -436,8 +436,7 @@ impl StagesArgs {
             scene: SceneArgs::default(),
             rules: RuleArgs::default(),
             out: PathBuf::from("out"),
-            png: PngEncoding::Linear,
-            exr_compression: ExrCompression::None,
+            files: FileArgs::default(),
         }
     }
 }

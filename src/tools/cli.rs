@@ -173,8 +173,8 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
     // Every file of every stage is renamed into place at the end, together: an
     // error or Ctrl-C on the way leaves the folder as it was.
     let mut pending = Pending::new()
-        .with_png(args.png)
-        .with_exr(args.exr_compression);
+        .with_png(args.files.png)
+        .with_exr(args.files.exr_compression);
     pending.folder(&args.out)?;
     // The stage folders are raystep's own names: a link or a file at one is
     // refused now, before anything is rendered.
@@ -194,7 +194,7 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
     let start = Instant::now();
     let mut page = Vec::new(); // a row of index.html per stage
     let mut sheet = crate::io::contact::ContactSheet::new(crate::io::contact::THUMBNAIL_WIDTH)
-        .with_png(args.png);
+        .with_png(args.files.png);
     for stage in Stage::ALL {
         bar.set_message(format!("rendering {}", stage.folder()));
         let dir = args.out.join(stage.folder());
@@ -272,8 +272,8 @@ fn render_one(args: RenderArgs) -> Result<(), Error> {
     let start = Instant::now();
     let (scene, settings) = prepare(&args.frame)?;
     let mut pending = Pending::new()
-        .with_png(args.png)
-        .with_exr(args.exr_compression);
+        .with_png(args.files.png)
+        .with_exr(args.files.exr_compression);
     pending.folder(&args.out)?;
     crate::io::output::check_final_names(&crate::io::output::frame_files(
         &args.out,

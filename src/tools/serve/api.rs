@@ -446,7 +446,7 @@ impl Studio {
             scene,
             settings,
             buffer,
-            png: args.png,
+            png: args.files.png,
             version,
             view,
             key,
