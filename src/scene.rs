@@ -231,17 +231,6 @@ impl<T: Real> Object<T> {
         }
     }
 
-    /// The point this surface is computed from: a sphere's centre, a plane's
-    /// point (the one nearest the origin). The `auto` offset grows with the
-    /// distance of a hit point from it.
-    #[inline]
-    pub fn anchor(&self) -> T::Vec3 {
-        match &self.shape {
-            Shape::Sphere(s) => s.center,
-            Shape::Plane(pl) => pl.point,
-        }
-    }
-
     /// The size of the numbers this surface is computed from (the largest
     /// coordinate of the centre plus the radius, or of the plane's point): rounding
     /// errors of anything computed on it grow with this (the `scene` offset).
