@@ -419,23 +419,7 @@ fn diff_answers_the_figures_raystep_diff_gives_for_the_two_renders() {
         String::from_utf8_lossy(&reply.body)
     );
     let api = reply.json();
-    for key in [
-        "schema",
-        "width",
-        "height",
-        "pixels",
-        "threshold",
-        "fail_percent",
-        "over_threshold",
-        "over_threshold_percent",
-        "over_one_step",
-        "largest",
-        "largest_at",
-        "rmse",
-        "clipped",
-        "non_finite",
-        "different",
-    ] {
+    for key in std::iter::once("schema").chain(common::DIFF_FIGURES) {
         assert_eq!(api[key], cli[key], "{key}");
     }
     assert!(api["over_one_step"].as_u64().unwrap() > 100);

@@ -5,6 +5,25 @@ use raystep::aov::Frame;
 use raystep::scene::Scene;
 use raystep::stages::Stages;
 
+/// The figures `raystep diff --json` prints (besides the two files' names and
+/// `schema`), which the studio's `/api/diff` gives too.
+pub const DIFF_FIGURES: [&str; 14] = [
+    "width",
+    "height",
+    "pixels",
+    "threshold",
+    "fail_percent",
+    "over_threshold",
+    "over_threshold_percent",
+    "over_one_step",
+    "largest",
+    "largest_at",
+    "rmse",
+    "clipped",
+    "non_finite",
+    "different",
+];
+
 /// The built-in figure-1 scene at `width` × `height`.
 pub fn seed(width: u32, height: u32) -> Scene {
     let mut scene = raystep::io::scene_file::seed();
