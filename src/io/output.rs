@@ -162,6 +162,9 @@ impl Pending {
             path: dir.to_path_buf(),
             message,
         };
+        // A folder written into earlier that has moved since: a folder under it
+        // (a stage's) would otherwise be made again at the old path.
+        self.check_folders()?;
         if dir.exists() && !dir.is_dir() {
             return Err(fail(
                 "it is a file, not a folder; give --out a folder".into(),
@@ -245,14 +248,7 @@ impl Pending {
         // Held while the files are renamed: a watchdog after Ctrl-C waits for it.
         let mut noted = crate::interrupt::files();
         crate::error::check_interrupt()?;
-        if let Some((dir, _, _)) = self.folders.iter().find(|(d, _, was)| identity(d) != *was) {
-            return Err(Error::Output {
-                path: dir.clone(),
-                message: "this folder was moved or replaced while raystep rendered into it; \
-                          nothing was put in place, and the files begun in it were removed"
-                    .into(),
-            });
-        }
+        self.check_folders()?;
         let finals: Vec<PathBuf> = self.files.iter().map(|(_, path)| path.clone()).collect();
         check_final_names(&finals)?;
         let present = |path: &Path| fs::symlink_metadata(path).ok();
@@ -327,6 +323,19 @@ impl Pending {
         self.created.clear();
         crate::interrupt::committed();
         Ok(())
+    }
+
+    /// Refuse to go on once a folder written into was moved or replaced.
+    fn check_folders(&self) -> Result<(), Error> {
+        match self.folders.iter().find(|(d, _, was)| identity(d) != *was) {
+            Some((dir, _, _)) => Err(Error::Output {
+                path: dir.clone(),
+                message: "this folder was moved or replaced while raystep rendered into it; \
+                          nothing was put in place, and the files begun in it were removed"
+                    .into(),
+            }),
+            None => Ok(()),
+        }
     }
 
     /// Where the temporary file `temporary` is now: at its path, unless its folder
