@@ -666,7 +666,7 @@ fn chapter_11_tells_the_story_explain_tells_now() {
     let story = raystep::tools::explain::explain(&scene, &settings, 74, 125);
     assert!(snap.contains(story.to_string().trim_end()));
     // What the chapter reads off the story.
-    for quoted in ["at t = 4.65", "12.17 away", "at 2.78", "1.1e-11"] {
+    for quoted in ["at t = 4.65", "12.17 away", "at 2.78", "8.8e-12"] {
         assert!(text.contains(quoted), "chapter 11 should say {quoted:?}");
     }
     assert!(story

@@ -62,7 +62,7 @@ use crate::scene::{on_plane, on_sphere};
 use crate::scene::{Light, Object, Scene, Shape};
 use crate::shade::blinn_phong::{factors, whole_exponent, Viewer};
 use crate::shade::reflection::reflect;
-use crate::shade::shadow::{plane_height, sphere_height, step_out, step_out_by_scene, Offset};
+use crate::shade::shadow::{plane_height, sphere_step, step_out, step_out_by_scene, Offset};
 use crate::sphere::outward_normal;
 use crate::sphere::Method;
 use crate::stages::Stage;
@@ -184,7 +184,7 @@ pub struct Packed<T: Laned> {
     shape: Shape4<T>,
     /// The sphere's radius (zero for a plane).
     radius: T::Lanes,
-    /// [`Object::magnitude`], for the `auto` offset.
+    /// [`Object::magnitude`], for the `scene` offset.
     magnitude: T::Lanes,
     /// `ka·la`.
     ambient: V3<T>,
@@ -988,7 +988,23 @@ impl<T: Laned> Fast<T> {
     ) -> V3<T> {
         match self.book.offset {
             Offset::Fixed(step) => point + normal.scale(T::Lanes::splat(T::of(step))),
-            Offset::Auto | Offset::Scene => {
+            Offset::Auto => {
+                let shape = &object.shape;
+                let spheres = shape.spheres & alive;
+                let u = T::Lanes::splat(T::UNIT_ROUNDOFF);
+                let sphere = || sphere_step(point, normal, shape.point, object.radius, u);
+                if spheres == alive {
+                    return sphere();
+                }
+                let on_surface = on_plane(point, shape.point, shape.normal);
+                let plane = step_out(on_surface, normal, plane_height(on_surface, shape.point, u));
+                if spheres == 0 {
+                    plane
+                } else {
+                    V3::select(T::Lanes::mask(spheres), sphere(), plane)
+                }
+            }
+            Offset::Scene => {
                 let shape = &object.shape;
                 let spheres = shape.spheres & alive;
                 let sphere = || on_sphere(shape.point, normal, object.radius);
@@ -1003,23 +1019,7 @@ impl<T: Laned> Fast<T> {
                     }
                 };
                 let u = T::Lanes::splat(T::UNIT_ROUNDOFF);
-                match self.book.offset {
-                    Offset::Scene => step_out_by_scene(on_surface, normal, object.magnitude, u),
-                    _ => {
-                        let sphere = || sphere_height(point, shape.point, object.radius, u);
-                        let height = if spheres == alive {
-                            sphere()
-                        } else {
-                            let plane = plane_height(on_surface, shape.point, u);
-                            if spheres == 0 {
-                                plane
-                            } else {
-                                T::Lanes::mask(spheres).select(sphere(), plane)
-                            }
-                        };
-                        step_out(on_surface, normal, height)
-                    }
-                }
+                step_out_by_scene(on_surface, normal, object.magnitude, u)
             }
         }
     }

@@ -14,7 +14,7 @@ use crate::error::Error;
 use crate::plane::Plane;
 use crate::real::Precision;
 use crate::scene::{Light, Material, Object, Role, Scene, Shape};
-use crate::shade::shadow::{auto_step, pass_over};
+use crate::shade::shadow::{pass_over, sphere_height};
 use crate::sphere::Sphere;
 use crate::Vec3;
 
@@ -963,7 +963,7 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
                 let far = s.center + s.center.normalize_or(Vec3::X) * s.radius;
                 let band = pass_over(F32_U, s.radius, far);
                 if band > F32_TERMINATOR_WARNING {
-                    let step = auto_step(F32_U, s.radius, far);
+                    let step = sphere_height(far, s.radius, F32_U);
                     warnings.push(format!(
                         "{at}: its centre is {:.1e} radii from the origin; float32 places its \
                          points to within {step:.1e} ({:.2} of its radius), so shadow rays \

@@ -19,14 +19,23 @@ pub const TUTORIAL_STEP: f64 = 1e-5;
 /// sphere near the terminator.
 pub const SCENE_FACTOR: f64 = 8.0;
 
-/// Unit roundoffs of the distance from the surface's anchor (a sphere's centre,
-/// a plane's point) in the `auto` step: the bound derived at [`sphere_height`] is 9.5
-/// for a sphere and 8 for a plane, to first order.
+/// Unit roundoffs of the radius in the `auto` step over a sphere: the bound
+/// derived at [`sphere_step`] is 6.5, to first order; the rest covers the terms
+/// of second order and the rounding of the bound itself.
+pub const RADIUS_UNITS: f64 = 7.0;
+
+/// Unit roundoffs of the distance of the hit point from the origin in the `auto`
+/// step over a sphere: the bound derived at [`sphere_step`] is 1, to first order.
+pub const POINT_UNITS: f64 = 2.0;
+
+/// Unit roundoffs of the distance from a plane's anchor (its point nearest the
+/// origin) in the `auto` step over a plane: the bound derived at
+/// [`plane_height`] is 8, to first order.
 pub const ANCHOR_UNITS: f64 = 10.0;
 
-/// Unit roundoffs of the distance of the point from the origin in the `auto`
-/// step: the bound derived at [`sphere_height`] is 2, to first order; the third
-/// covers the terms of second order and the rounding of the bound itself.
+/// Unit roundoffs of the projected point's distance from the origin in the
+/// `auto` step over a plane: the bound derived at [`plane_height`] is 2, to
+/// first order.
 pub const ORIGIN_UNITS: f64 = 3.0;
 
 /// How far a hit point is moved along the normal before a shadow or reflected ray
@@ -39,9 +48,10 @@ pub enum Offset {
     /// roundoffs of the size of the surface's numbers (raystep's first automatic
     /// offset, kept for comparison).
     Scene,
-    /// Put the point back on the surface, then step out by a bound of the error
-    /// of that point and of the next ray's test ([`step_out`]): a few unit
-    /// roundoffs of the radius and of the point's distance from the origin.
+    /// Move the point to a height above the surface that is a bound of the
+    /// error of that move and of the next ray's test ([`sphere_step`],
+    /// [`step_out`]): a few unit roundoffs of the radius and of the point's
+    /// distance from the origin.
     #[default]
     Auto,
 }
@@ -99,14 +109,13 @@ pub fn step_off<T: Real>(
     let u = T::UNIT_ROUNDOFF;
     match offset {
         Offset::Fixed(step) => point + normal * T::of(step),
-        Offset::Auto => {
-            let on_surface = surface.surface_point(point, normal);
-            let height = match &surface.shape {
-                Shape::Sphere(s) => sphere_height(point, s.center, s.radius, u),
-                Shape::Plane(pl) => plane_height(on_surface, pl.point, u),
-            };
-            step_out(on_surface, normal, height)
-        }
+        Offset::Auto => match &surface.shape {
+            Shape::Sphere(s) => sphere_step(point, normal, s.center, s.radius, u),
+            Shape::Plane(pl) => {
+                let on_surface = surface.surface_point(point, normal);
+                step_out(on_surface, normal, plane_height(on_surface, pl.point, u))
+            }
+        },
         Offset::Scene => {
             let on_surface = surface.surface_point(point, normal);
             step_out_by_scene(on_surface, normal, surface.magnitude(), u)
@@ -114,62 +123,70 @@ pub fn step_off<T: Real>(
     }
 }
 
-/// The `auto` step: from a point `on_surface` just put back on a surface (a
-/// sphere's `C + N·r`, a plane's `p − n·⟨p − P, n⟩`), out along the unit `normal`
-/// by `height`, a bound of what rounding can do to it ([`sphere_height`],
-/// [`plane_height`]). A point so far out that the bound overflows (a plane met
-/// at t ~ 1e300) would step by ∞ and turn every coordinate it touches into NaN:
-/// the step is at most `STEP_CAP`, which no scene within the limits comes near.
-/// (For any [`Vec3Num`]: the fast engine steps four points at once with this
-/// body.)
-#[inline(always)]
-pub fn step_out<V: Vec3Num>(on_surface: V, normal: V, height: V::Num) -> V {
-    let height = -(-height).max(-V::Num::of(STEP_CAP));
-    on_surface + normal * height
-}
-
-/// The `auto` step's height over a sphere of centre `center` and radius
-/// `radius`, for the hit point `point` (P, as computed), with `u` the unit
-/// roundoff: `h = u·(10·r + 3·(‖P‖ + |‖P − C‖ − r|))`.
+/// The `auto` step over a sphere of centre `center` and radius `radius`, from
+/// the hit point `point` (P, as computed) along the unit `normal` (N, computed
+/// from P): to the height `h = u·(7·r + 2·‖P‖)` above the sphere, with `u` the
+/// unit roundoff, in one move, `P + N·((r − ‖P − C‖) + h)`.
 ///
 /// Why. Every operation is exact up to a factor `1 + δ`, `|δ| ≤ u` (Higham's
-/// model; `γ_n = n·u/(1 − n·u)` bounds `n` such factors). Follow the point
-/// `S = C + N·r` through, measuring heights along the normal:
+/// model; `γ_n = n·u/(1 − n·u)` bounds `n` such factors). Follow the new
+/// origin `O` through, measuring heights along the normal:
 ///
-/// 1. `N = (P − C)·(1/‖P − C‖)` is a unit vector up to `‖N‖ = 1 ± 4.5u` (three
-///    squares summed, a square root, a reciprocal, a product), so `C + N·r`
-///    is `4.5u·r` off the sphere before it is rounded; pbrt-v4 bounds its
-///    re-projected sphere point by `γ_5·|p|` for the same reason.
-/// 2. `N·r` and `C + N·r` are rounded: `u·r` and `u·‖S‖` more along the normal.
-/// 3. The step `S + N·h` is rounded too: `u·‖S‖` (and `u·h`).
+/// 1. `d = ‖P − C‖` as computed is within `3.5u·r` of P's true distance from
+///    the centre (a difference, three squares summed, a square root), so
+///    `r − d` puts P back on the sphere up to `3.5u·r`. (pbrt-v4 re-projects
+///    its sphere hit points for the same reason: the hit point's error grew
+///    with the root's, the projection's depends only on the numbers it is
+///    computed from.)
+/// 2. `N` is a unit vector up to `‖N‖ = 1 ± 4.5u` and points along P's radius
+///    up to a few `u`; it multiplies only the short move `(r − d) + h`, a few
+///    `u` of the distances, so its error counts `u²` (second order), as do the
+///    roundings of the move's length and of `N·(…)`.
+/// 3. The sum `P + N·(…)` is rounded: `u·‖O‖`, and `‖O‖ ≤ ‖P‖` to first order.
 /// 4. The next ray's test must see the origin outside: it computes
 ///    `c = ‖C − O‖² − r²` and counts the sphere only if `c > 0`. Rounding of
 ///    `C − O`, of the sum of squares (`γ_3`) and of `r²` can turn a true `c > 0`
 ///    negative unless `‖C − O‖ > r·(1 + 3u)`: `3u·r` more.
 ///
 /// So the origin is outside, as the next test sees it, once
-/// `h > 9.5u·r + 2u·‖S‖` (to first order in `u`). `S` lies on `P`'s radius, so
-/// `‖S‖ ≤ ‖P‖ + ‖S − P‖ = ‖P‖ + |‖P − C‖ − r|`, and `h` rounds both up. Measured
-/// from `P`, the bound needs nothing of the normal: the tracer computes it while
-/// it computes the normal, not after (measured at `S`, it waited for the
-/// normal's square root and division, and the book's engine took 6 % longer
-/// a frame).
+/// `h > 6.5u·r + u·‖P‖` (to first order in `u`); the step rounds both up. It
+/// needs nothing of the normal but the direction, and `‖P − C‖` is the length
+/// the normal is computed from. (raystep first put the point back on the
+/// sphere as `S = C + N·r` and then stepped out from `S`: that rounds twice
+/// where this rounds once, and trusts `‖N‖ = 1` over the whole radius, which
+/// cost `9.5u·r + 2u·‖S‖`.)
 ///
 /// Nothing here is the size of the scene: a sphere far from the origin steps
-/// out by `3u` of the point's distance (the spacing of the numbers there, which
+/// out by `2u` of the point's distance (the spacing of the numbers there, which
 /// no method can beat), not by a multiple of its largest coordinate, and `‖P‖`
 /// is at most the ray's origin plus the distance it travelled, `‖O‖ + t`.
 #[inline(always)]
-pub fn sphere_height<V: Vec3Num>(point: V, center: V, radius: V::Num, u: V::Num) -> V::Num {
-    // ‖S‖ ≤ ‖P‖ + ‖S − P‖, and S lies on P's radius: ‖S − P‖ = |‖P − C‖ − r|.
-    let gap = (point - center).length() - radius;
-    let gap = gap.max(-gap);
-    u * (V::Num::of(ANCHOR_UNITS) * radius + V::Num::of(ORIGIN_UNITS) * (point.length() + gap))
+pub fn sphere_step<V: Vec3Num>(point: V, normal: V, center: V, radius: V::Num, u: V::Num) -> V {
+    let back_to_surface = radius - (point - center).length();
+    point + normal * (back_to_surface + sphere_height(point, radius, u))
+}
+
+/// The height above a sphere of radius `radius` that [`sphere_step`] moves a
+/// hit point `point` to: `h = u·(7·r + 2·‖P‖)`, at most `STEP_CAP`.
+#[inline(always)]
+pub fn sphere_height<V: Vec3Num>(point: V, radius: V::Num, u: V::Num) -> V::Num {
+    let height = u * (V::Num::of(RADIUS_UNITS) * radius + V::Num::of(POINT_UNITS) * point.length());
+    capped(height)
+}
+
+/// The `auto` step over a plane: from a point `on_surface` just put back on
+/// the plane (`p − n·⟨p − A, n⟩`), out along the unit `normal` by `height`, a
+/// bound of what rounding can do to it ([`plane_height`]).
+/// (For any [`Vec3Num`]: the fast engine steps four points at once with this
+/// body.)
+#[inline(always)]
+pub fn step_out<V: Vec3Num>(on_surface: V, normal: V, height: V::Num) -> V {
+    on_surface + normal * capped(height)
 }
 
 /// The `auto` step's height at a point `on_surface` of a plane whose anchor
 /// (its point nearest the origin) is `anchor`: `h = u·(10·‖S − A‖ + 3·‖S‖)`.
-/// Followed as [`sphere_height`] follows a sphere's point, the projected point
+/// Followed as [`sphere_step`] follows a sphere's point, the projected point
 /// needs `h > 8u·‖S − A‖ + 2u·‖S‖`: the dot product `⟨S − A, n⟩` is where its
 /// error grows with the distance from the anchor, once when the point is
 /// projected and once in the next test. `‖S‖` is at most the ray's origin plus
@@ -182,28 +199,28 @@ pub fn plane_height<V: Vec3Num>(on_surface: V, anchor: V, u: V::Num) -> V::Num {
 // ANCHOR_END: step_off
 
 /// The largest `auto` step: finite in float32 too, and beyond any step a scene
-/// inside the limits (coordinates up to 1e15) can need.
+/// inside the limits (coordinates up to 1e15) can need. A point so far out that
+/// the bound overflows (a plane met at t ~ 1e300) would step by ∞ and turn every
+/// coordinate it touches into NaN.
 pub const STEP_CAP: f64 = 1e38;
 
-/// The length of the `auto` step at a point `on_surface` of a surface of radius
-/// `radius` (for a plane: the distance from its anchor), in unit roundoffs `u`:
-/// [`plane_height`]'s bound, as one number, and [`sphere_height`]'s where
-/// `on_surface` is the sphere's point farthest from the origin (`‖C‖ + r` from
-/// it), for the accuracy judge and the float32 warnings.
-pub fn auto_step(u: f64, radius: f64, on_surface: crate::Vec3) -> f64 {
-    u * (ANCHOR_UNITS * radius + ORIGIN_UNITS * on_surface.length())
+/// `height`, or [`STEP_CAP`] if it is larger (or ∞).
+#[inline(always)]
+fn capped<N: Num>(height: N) -> N {
+    -(-height).max(-N::of(STEP_CAP))
 }
 
 /// How far round the terminator a shadow ray that starts the `auto` step `h` above
-/// a sphere of radius `radius` passes over it: it enters the sphere at `|L·N| = s`
-/// only if `(r + h)·√(1 − s²) ≤ r`, so for `s` below about `√(2h/r)` it clears it.
-/// In float32 that is at least `√(20u)` = 1.1e-3. (This is the nominal step's
+/// a sphere of radius `radius`, at its point `on_surface`, passes over it
+/// ([`sphere_height`]): it enters the sphere at `|L·N| = s` only if
+/// `(r + h)·√(1 − s²) ≤ r`, so for `s` below about `√(2h/r)` it clears it.
+/// In float32 that is at least `√(14u)` = 9.1e-4. (This is the nominal step's
 /// band, which the float32 warnings quote; the band `raystep accuracy` judges
 /// with, `tools::accuracy::terminator_band`, takes the height the step's origin
 /// actually has, the step plus the point's error, and adds the `8u` by which
 /// the next test's `Δ/4` may be off.)
 pub fn pass_over(u: f64, radius: f64, on_surface: crate::Vec3) -> f64 {
-    (2.0 * auto_step(u, radius, on_surface) / radius).sqrt()
+    (2.0 * sphere_height(on_surface, radius, u) / radius).sqrt()
 }
 
 /// The `scene` step: out along the unit `normal` by [`SCENE_FACTOR`] unit

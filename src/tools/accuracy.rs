@@ -14,7 +14,7 @@ use crate::ray::Ray;
 use crate::real::{Precision, Real, Vector};
 use crate::render::{Settings, Tracer};
 use crate::scene::{Object, Scene, Shape};
-use crate::shade::shadow::{auto_step, step_off, Offset};
+use crate::shade::shadow::{step_off, Offset};
 use crate::sphere::{Method, Sphere};
 use crate::stages::Stages;
 use crate::Vec3;
@@ -144,7 +144,7 @@ pub const GRAZE_UNITS: f64 = 8.0;
 
 /// The terminator band of a sphere of radius `radius` at a point whose `auto`
 /// shadow ray starts `height` above the sphere (the step `h` of
-/// [`crate::shade::shadow::step_out`] plus the point's own error, which the
+/// [`crate::shade::shadow::sphere_step`] plus the point's own error, which the
 /// judge measures), for a precision of unit roundoff `u`: the larger of
 /// [`TERMINATOR_BAND`] and `√(2·height/r + 8u)`.
 ///
@@ -155,8 +155,8 @@ pub const GRAZE_UNITS: f64 = 8.0;
 /// computes `Δ/4` within [`GRAZE_UNITS`]`·u·r²`, so it may answer either way
 /// for `s²` within `8u` of that. No offset that keeps origins outside does
 /// better: `height` is at least what rounding can put the point off the sphere
-/// by (a few `u·r`), so in float32 the band is more than 1e-3 on every sphere
-/// (`√(2·4.5u + 8u)` = 1.0e-3 at the very least, about 1.3e-3 on the fake
+/// by (a few `u·r`), so in float32 the band is about 1e-3 on every sphere
+/// (`√(2·3.5u + 8u)` = 9.5e-4 at the very least, about 1.15e-3 on the fake
 /// floor); in float64 it is [`TERMINATOR_BAND`] for any sphere within 1e9
 /// radii of the origin. (The judge adds the angle by which rounding moved that
 /// origin along the surface, seen from the centre, beside the point it judges.)
@@ -582,7 +582,7 @@ fn reference_lit(
     };
     let to_light = (light - on_surface).normalize();
     let facing = to_light.dot(normal);
-    let (band, size) = match object.shape {
+    let band = match object.shape {
         Shape::Sphere(s) => {
             // The bound's origin, from the centre: its height above the sphere, and
             // how far rounding moved it along the surface from the point judged
@@ -590,10 +590,9 @@ fn reference_lit(
             let from_centre = bound_origin - s.center;
             let height = (from_centre.length() - s.radius).abs();
             let aside = (from_centre - normal * from_centre.dot(normal)).length();
-            let band = terminator_band(u, s.radius, height) + aside / s.radius;
-            (band, s.radius)
+            terminator_band(u, s.radius, height) + aside / s.radius
         }
-        Shape::Plane(pl) => (TERMINATOR_BAND, on_surface.distance(pl.point)),
+        Shape::Plane(_) => TERMINATOR_BAND,
     };
     if facing.abs() < TERMINATOR_BAND {
         return None;
@@ -602,7 +601,8 @@ fn reference_lit(
     if facing < 0.0 && matches!(object.shape, Shape::Sphere(_)) {
         return Some((false, facing, band));
     }
-    let slack = auto_step(u, size, on_surface);
+    // How far from the point judged the bound's shadow ray starts.
+    let slack = on_surface.distance(bound_origin);
     let ray = Ray {
         origin: on_surface,
         direction: to_light,
