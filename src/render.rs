@@ -163,6 +163,9 @@ pub trait Observer<T: Real> {
     /// A shadow ray leaves the stepped-off point towards a light this far from the
     /// hit point.
     fn shadow_ray(&mut self, _ray: &Ray<T>, _light_distance: T) {}
+    /// No shadow ray was cast: the light is below the horizon of the sphere the
+    /// point lies on (`N·L` = `l_dot_n` < 0), which shadows it.
+    fn own_shadow(&mut self, _l_dot_n: T) {}
     /// Blinn-Phong was computed, with `L` and `V`.
     fn shaded(&mut self, _terms: &Terms<T>, _to_light: T::Vec3, _to_viewer: T::Vec3) {}
     /// The segment added `illumination` (before its weight); the path's sum is now
@@ -311,7 +314,13 @@ impl<T: Real> Tracer<T> {
 
             // ANCHOR: shadow_test
             // Shadow: a point that does not see the light ends the path, black.
-            let lit = !self.stages.shadow || {
+            let lit = if !self.stages.shadow {
+                true
+            } else if shadow::own_shadow(object, normal, to_light, self.offset) {
+                // Its own sphere hides the light: no ray to ask (chapter 9).
+                look.own_shadow(normal.dot(to_light));
+                false
+            } else {
                 let light_distance = self.light.position.distance(point);
                 look.shadow_ray(&Ray::new(shifted, to_light), light_distance);
                 !self.in_shadow(shifted, to_light, light_distance)

@@ -65,27 +65,34 @@ const SCENE: Offset = Offset::Scene;
 /// and no wrong shadow outside the terminator band on any case, those float32
 /// warns about or refuses included. The band is 1e-3, or where it is wider the
 /// one the bound's own step makes: √(2h/r + 8u), with h the height of that
-/// step's origin above the sphere (`terminator_band`). In float32 it is wider
-/// than 1e-3 on every sphere, and `wrong_shadows_1e3` counts what lies between:
-/// measured on the fake floor lit from near its horizon.
+/// step's origin above the sphere (`terminator_band`), which in float32 is
+/// wider than 1e-3 on most spheres. But `auto` asks no shadow ray on a sphere's
+/// own dark side (`own_shadow`: the sign of N·L), so on every case float32
+/// renders without a warning not one shadow is wrong outside 1e-3 itself
+/// (`wrong_shadows_1e3`).
 #[test]
 fn float32_with_the_bound_passes_every_case_within_its_bands() {
+    let mut plain = 0;
     for (name, _) in CASES {
         let m = run(name, F32, Stable, AUTO);
         assert_eq!((m.false_hits, m.false_misses), (0, 0), "{name}: {m:?}");
         assert_eq!(m.stuck, 0.0, "{name}");
         assert_eq!(m.wrong_shadows, 0, "{name}: {m:?}");
         assert!(m.wrong_shadows_1e3 >= m.wrong_shadows, "{name}: {m:?}");
+        if m.limit == "ok" {
+            assert_eq!(m.wrong_shadows_1e3, 0, "{name}: {m:?}");
+            plain += 1;
+        }
     }
-    // The floor's dark side lit from near its horizon: the step, h ≈ 3.8e-3 above
-    // it, lifts no shadow ray over the horizon past 1e-3 (measured: 0; the
-    // two-move step from C + N·r, 5.4e-3, left 1,120 between 1e-3 and its band).
+    assert!(
+        plain >= 12,
+        "only {plain} cases render in float32 without a warning"
+    );
+    // The floor's dark side lit from near its horizon, where a shadow ray from the
+    // step (3.8e-3 above the floor) would pass over its horizon up to
+    // |L·N| = √(2h/r) ≈ 1e-3: the sign of N·L decides it.
     let floor = run("horizon-low-light", F32, Stable, AUTO);
     assert_eq!(floor.wrong_shadows_1e3, 0, "{floor:?}");
-    // Between 1e-3 and the band there still are points, where two spheres touch
-    // (measured: 18; the two-move step left 38).
-    let touching = run("touching", F32, Stable, AUTO);
-    assert!(touching.wrong_shadows_1e3 > 0, "{touching:?}");
     // float64's band is 1e-3 itself: nothing between.
     let floor = run("horizon-low-light", F64, Stable, AUTO);
     assert_eq!(floor.wrong_shadows_1e3, 0, "{floor:?}");

@@ -160,6 +160,11 @@ fn telling_pixels_of_the_seed_scene() {
             first_pixel(&frame, |p| p.object == 3 && p.shadow == 0.0),
         ),
         ("path-to-max-depth", deepest),
+        // A sphere's own dark side: in shadow with the primary ray alone.
+        (
+            "sphere-dark-side",
+            first_pixel(&frame, |p| p.object != 3 && p.shadow == 0.0 && p.rays == 1),
+        ),
     ];
     for (name, (x, y)) in pixels {
         let story = explain(&scene, &settings, x, y);

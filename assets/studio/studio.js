@@ -685,6 +685,12 @@ function tell(story) {
             (blocker ? `blocked by object ${blocker[0]} at ${num(blocker[1])}` : "nothing in between"),
         ]);
       }
+      if (hit.own_shadow !== null && hit.own_shadow !== undefined) {
+        rows.push([
+          "shadow ray",
+          `none: the light is below this sphere's horizon (N·L = ${num(hit.own_shadow)}), so the sphere shadows the point`,
+        ]);
+      }
       if (hit.shading) {
         const s = hit.shading;
         rows.push(["L·N, N·H", `${num(s.l_dot_n)}, ${num(s.n_dot_h)} (exponent ${num(s.exponent)})`]);

@@ -746,13 +746,26 @@ impl<T: Laned> Fast<T> {
             let to_light = (light - shifted).normalize();
 
             // Shadow: the lanes whose point does not see the light end, black.
+            // On a sphere's own dark side no ray is asked (`own_shadow`).
             let lit = if let Some(light_distance) = light_distance {
-                count(&mut traced.shadow_rays, alive);
+                let away = match self.book.offset {
+                    Offset::Auto => {
+                        let zero = T::Lanes::splat(T::of(0.0));
+                        object.shape.spheres & normal.dot(to_light).lt(zero).bits()
+                    }
+                    _ => 0,
+                };
+                let cast = alive & !away;
+                count(&mut traced.shadow_rays, cast);
                 let shadow_ray = Packet {
                     origin: shifted,
                     direction: to_light,
                 };
-                alive & !self.blocked_packet(&shadow_ray, light_distance, alive)
+                if cast == 0 {
+                    0
+                } else {
+                    cast & !self.blocked_packet(&shadow_ray, light_distance, cast)
+                }
             } else {
                 alive
             };

@@ -54,9 +54,11 @@ pub const MIN_RADIUS_RATIO: f64 = 1e-6;
 /// renders one at [`MIN_RADIUS_RATIO`].
 pub const MIN_RADIUS_RATIO_F64: f64 = MIN_RADIUS_RATIO * (f64::EPSILON / f32::EPSILON as f64);
 
-/// The widest terminator float32 may leave before [`check_precision`] warns: the
-/// `auto` step makes a shadow ray start a height `h` above its sphere, and it
-/// passes over it for `|L·N|` below about `√(2h/r)`.
+/// How coarsely float32 may place a sphere's points before [`check_precision`]
+/// warns, as the band a shadow ray from the `auto` step would pass over the
+/// sphere in: the step `h` is a bound of the points' error, and such a ray passes
+/// over its sphere for `|L·N|` below about `√(2h/r)`. (`auto` asks no ray on a
+/// sphere's own dark side, but its points, normals and outline are as coarse.)
 pub const F32_TERMINATOR_WARNING: f64 = 1e-2;
 
 /// Largest accepted `max_depth`.
@@ -933,7 +935,7 @@ fn lit_from_off(plane: &Plane, at: &str, light: Vec3, ratio: f64) -> Result<(), 
 /// `precision` resolves. In float64: nothing more. In float32: the loader's
 /// limits again with [`MIN_RADIUS_RATIO`] (an error, naming float64 as the way
 /// out), and warnings for what float32 renders but coarsely: a sphere whose
-/// shadow edge is uncertain beyond [`F32_TERMINATOR_WARNING`], and spheres that
+/// points it places coarsely ([`F32_TERMINATOR_WARNING`]), and spheres that
 /// float32 makes one.
 pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String>, String> {
     if precision == Precision::F64 {
@@ -966,9 +968,10 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
                     let step = sphere_height(far, s.radius, F32_U);
                     warnings.push(format!(
                         "{at}: its centre is {:.1e} radii from the origin; float32 places its \
-                         points to within {step:.1e} ({:.2} of its radius), so shadow rays \
-                         start that far out and its shadow's edge is uncertain up to \
-                         |L·N| = {band:.2}; float64 (the default precision) renders it to 1e-3",
+                         points to within {step:.1e} ({:.1e} of its radius), so its outline, \
+                         its normals and the rays that leave it are that coarse (a shadow ray \
+                         from there would pass over it up to |L·N| = {band:.2}); float64 (the \
+                         default precision) renders it to 1e-3",
                         s.center.length() / s.radius,
                         step / s.radius,
                     ));

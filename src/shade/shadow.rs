@@ -51,7 +51,8 @@ pub enum Offset {
     /// Move the point to a height above the surface that is a bound of the
     /// error of that move and of the next ray's test ([`sphere_step`],
     /// [`step_out`]): a few unit roundoffs of the radius and of the point's
-    /// distance from the origin.
+    /// distance from the origin. On a sphere's own dark side no shadow ray is
+    /// cast at all ([`own_shadow`]).
     #[default]
     Auto,
 }
@@ -233,6 +234,28 @@ pub fn step_out_by_scene<V: Vec3Num>(on_surface: V, normal: V, magnitude: V::Num
     on_surface + normal * bound
 }
 
+// ANCHOR: own_shadow
+/// Is the point in its own sphere's shadow? A sphere hides the light from
+/// every point of it where the light is below the horizon, `N·L < 0`, whatever
+/// else lies on the way, so raystep's `auto` offset asks no shadow ray there.
+/// The ray would say the same but near the terminator: started the step `h`
+/// above the sphere, it passes over it for `|N·L|` up to about `√(2h/r)`
+/// (chapter 9), where the sign of `N·L` errs only within a few unit roundoffs.
+/// The tutorial's step (`fixed`) and the `scene` step keep asking the ray, as
+/// the tutorial does; and a plane lights both of its faces.
+#[inline(always)]
+pub fn own_shadow<T: Real>(
+    surface: &Object<T>,
+    normal: T::Vec3,
+    to_light: T::Vec3,
+    offset: Offset,
+) -> bool {
+    offset == Offset::Auto
+        && matches!(surface.shape, Shape::Sphere(_))
+        && normal.dot(to_light) < T::of(0.0)
+}
+// ANCHOR_END: own_shadow
+
 // ANCHOR: in_shadow
 /// The tutorial's shadow test: cast a ray from the moved point `shifted` towards the
 /// light (`to_light`, a unit vector). The point is in shadow if an object is hit
@@ -257,6 +280,27 @@ pub fn in_shadow<T: Real>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_sphere_shadows_its_own_dark_side_under_auto_only() {
+        let ball = crate::bvh::test_ball(0.0, 0.0, 0.0, 1.0);
+        let up = crate::Vec3::Y;
+        let below = crate::Vec3::new(1.0, -1e-9, 0.0).normalize();
+        let above = crate::Vec3::new(1.0, 1e-9, 0.0).normalize();
+        assert!(own_shadow(&ball, up, below, Offset::Auto));
+        assert!(!own_shadow(&ball, up, above, Offset::Auto));
+        // The tutorial's step and the scene-sized one ask the shadow ray, as the
+        // tutorial does.
+        assert!(!own_shadow(&ball, up, below, Offset::TUTORIAL));
+        assert!(!own_shadow(&ball, up, below, Offset::Scene));
+        // A plane lights both of its faces.
+        let mut floor = ball;
+        floor.shape = Shape::Plane(crate::plane::Plane {
+            point: crate::Vec3::ZERO,
+            normal: up,
+        });
+        assert!(!own_shadow(&floor, up, below, Offset::Auto));
+    }
 
     #[test]
     fn offsets_parse_and_print_back() {

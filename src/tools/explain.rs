@@ -127,8 +127,11 @@ pub struct HitInfo {
     pub shifted: [f64; 3],
     /// How far it was moved.
     pub offset: f64,
-    /// The shadow ray, when the shadow stage is on.
+    /// The shadow ray, when the shadow stage is on and one is cast.
     pub shadow: Option<ShadowInfo>,
+    /// `N·L`, where the point lies on a sphere with the light below its horizon
+    /// and no shadow ray is cast (the `auto` offset's `own_shadow`).
+    pub own_shadow: Option<f64>,
     /// Does the point see the light? (Always, before the shadow stage.)
     pub lit: bool,
     /// Blinn-Phong's terms, when that stage is on and the point is lit.
@@ -303,6 +306,7 @@ impl<T: Real> Observer<T> for Story<'_, T> {
             shifted: shifted.to_f64().to_array(),
             offset: (shifted - point).length().to_f64(),
             shadow: None,
+            own_shadow: None,
             lit: true,
             shading: None,
             illumination: None,
@@ -323,6 +327,12 @@ impl<T: Real> Observer<T> for Story<'_, T> {
             light_distance,
             blocker: blocker.map(|b| (b.object, b.t.to_f64())),
         });
+    }
+
+    fn own_shadow(&mut self, l_dot_n: T) {
+        let hit = self.current_hit();
+        hit.lit = false;
+        hit.own_shadow = Some(l_dot_n.to_f64());
     }
 
     fn shaded(&mut self, t: &Terms<T>, to_light: T::Vec3, to_viewer: T::Vec3) {
@@ -575,7 +585,15 @@ impl std::fmt::Display for Explanation {
                 vec3(h.shifted)
             )?;
             match &h.shadow {
-                None => writeln!(f, "  shadow: stage off, the point counts as lit")?,
+                None => match h.own_shadow {
+                    Some(l_dot_n) => writeln!(
+                        f,
+                        "  the light is below this sphere's horizon (N·L = {})\n    → the sphere \
+                         shadows the point itself: in shadow, no shadow ray cast",
+                        num(l_dot_n)
+                    )?,
+                    None => writeln!(f, "  shadow: stage off, the point counts as lit")?,
+                },
                 Some(sh) => {
                     writeln!(
                         f,
