@@ -8,8 +8,9 @@
 # Defaults: 3 rounds, the scene `raystep generate spheres --count 100000 --seed 7`
 # (SCENE `figure1`: the built-in scene at 1920 × 1080; "" for the default when
 # naming patches), every patch of this folder. Each patch is applied to a
-# worktree of BASE (under
-# $CARGO_TARGET_DIR/experiments, target/experiments by default) and built there;
+# worktree of BASE (under $CARGO_TARGET_DIR/experiments, target/experiments by
+# default), on top of the patch its first line names if that line says
+# "Applies after: OTHER.patch", and built there;
 # then each round runs `raystep bench SCENE --runs 5 --no-yardstick --json` with
 # BASE's binary and each patched one, and prints the fast engine's median frame on
 # two threads and on one. The README beside this script says what each patch is
@@ -38,10 +39,15 @@ if [[ ! -d $tree ]]; then
   git -C "$root" worktree add --detach "$tree" "$BASE" >/dev/null
 fi
 build() { # name [patch]
-  git -C "$tree" checkout -q --detach "$BASE" -- . 2>/dev/null || true
   git -C "$tree" reset -q --hard "$BASE"
   git -C "$tree" clean -qfd
-  if [[ -n ${2:-} ]]; then git -C "$tree" apply "$2"; fi
+  if [[ -n ${2:-} ]]; then
+    # A patch that says "Applies after: OTHER.patch" goes on top of that one.
+    local after
+    after=$(sed -n 's/^Applies after: //p' "$2" | head -n 1)
+    if [[ -n $after ]]; then git -C "$tree" apply "$(dirname "$2")/$after"; fi
+    git -C "$tree" apply "$2"
+  fi
   (cd "$tree" && CARGO_TARGET_DIR=$work/build cargo build --release -q)
   cp "$work/build/release/raystep" "$work/bin/$1"
 }
