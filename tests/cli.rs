@@ -337,6 +337,45 @@ fn generate_writes_a_scene_that_loads_and_refuses_a_count_of_zero() {
 }
 
 #[test]
+fn generate_writes_a_million_spheres_as_their_recipe_and_the_recipe_loads() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = raystep(
+        dir.path(),
+        &["generate", "spheres", "--count", "1000000", "--seed", "7"],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let file = text(&out.stdout);
+    assert!(
+        file.len() < 1000,
+        "a recipe, not a list: {} bytes",
+        file.len()
+    );
+    assert!(
+        file.contains("[generate]\nspheres = 1000000\nseed = 7\n"),
+        "{file}"
+    );
+    assert!(text(&out.stderr).contains("recipe"), "it says so on stderr");
+    let scene = raystep::io::scene_file::parse(&file, "generated").unwrap();
+    assert_eq!(
+        scene.objects.len(),
+        1_000_001,
+        "a million spheres and the floor"
+    );
+    // Below the list's limit, --recipe asks for the recipe: the same scene as the list.
+    let list = raystep(dir.path(), &["generate", "spheres", "--count", "40"]);
+    let recipe = raystep(
+        dir.path(),
+        &["generate", "spheres", "--count", "40", "--recipe"],
+    );
+    assert!(text(&recipe.stderr).is_empty(), "{}", text(&recipe.stderr));
+    assert!(text(&recipe.stdout).contains("[generate]\nspheres = 40\nseed = 1\n"));
+    assert_eq!(
+        raystep::io::scene_file::parse(&text(&recipe.stdout), "recipe").unwrap(),
+        raystep::io::scene_file::parse(&text(&list.stdout), "list").unwrap()
+    );
+}
+
+#[test]
 fn chart_writes_its_csv_svg_and_png() {
     let dir = tempfile::tempdir().unwrap();
     let out = raystep(

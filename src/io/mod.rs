@@ -2,6 +2,7 @@
 //! contact sheet. They read the book's types and never change what is rendered.
 
 pub mod contact;
+pub mod generated;
 pub mod output;
 pub mod page;
 pub mod scene_file;

@@ -182,7 +182,7 @@ const SMALLEST_SCENE: &str =
     "    [camera]\n    position = [0, 0, 1]\n    [light]\n    position = [5, 5, 5]";
 
 /// Every section of a scene file and its keys, for "did you mean" and "belongs in".
-const SECTIONS: [(&str, &[&str]); 7] = [
+const SECTIONS: [(&str, &[&str]); 8] = [
     ("[image]", &["width", "height"]),
     ("[camera]", &["position"]),
     ("[screen]", &["left", "right", "top", "bottom"]),
@@ -213,6 +213,7 @@ const SECTIONS: [(&str, &[&str]); 7] = [
             "reflection",
         ],
     ),
+    ("[generate]", &["spheres", "seed"]),
 ];
 
 /// A TOML or schema error as a message: where (line and column), what, a hint when
@@ -350,6 +351,10 @@ fn plain_types(message: &str) -> String {
             "expected u32",
             "expected a whole number from 0 to 4294967295",
         )
+        .replace(
+            "expected u64",
+            "expected a whole number from 0 to 9223372036854775807",
+        )
         .replace("expected f64", "expected a number")
         .replace("expected a sequence", "expected a list")
         .replace(
@@ -394,7 +399,7 @@ fn hint(message: &str) -> Option<String> {
         ));
     }
     if message.starts_with("duplicate key") {
-        return Some("a key may be given once per section, and [image], [camera], [screen], [light] and [render] once per file (raystep has one camera and one point light)".into());
+        return Some("a key may be given once per section, and [image], [camera], [screen], [light], [render] and [generate] once per file (raystep has one camera and one point light)".into());
     }
     None
 }
@@ -495,6 +500,7 @@ struct SceneFile {
     sphere: Vec<SphereKeys>,
     #[serde(default)]
     plane: Vec<PlaneKeys>,
+    generate: Option<GenerateKeys>,
 }
 
 #[derive(Deserialize)]
@@ -571,6 +577,13 @@ struct PlaneKeys {
 struct SphereShape {
     center: Triple,
     radius: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GenerateKeys {
+    spheres: u32,      // required: 1 to 1,000,000 spheres, made after the [[sphere]]s
+    seed: Option<u64>, // default 1; as `raystep generate spheres --count N --seed S`
 }
 // ANCHOR_END: schema_objects
 
@@ -666,6 +679,25 @@ impl SceneFile {
                 material: material_keys!(keys).check(&at)?,
                 role: Role::Sphere,
             });
+        }
+        if let Some(keys) = self.generate {
+            let most = crate::io::generated::MAX_GENERATED;
+            let count = keys.spheres as usize;
+            if !(1..=most).contains(&count) {
+                return Err(format!(
+                    "generate.spheres = {}: must be from 1 to {most}",
+                    keys.spheres
+                ));
+            }
+            let seed = keys.seed.unwrap_or(1);
+            let made = crate::io::generated::objects(count, seed);
+            for (i, object) in made.enumerate() {
+                if let Shape::Sphere(shape) = &object.shape {
+                    let at = Lazy(|| format!("[generate] sphere number {} (seed {seed})", i + 1));
+                    placed(shape, &at, camera, light.position, MIN_RADIUS_RATIO_F64)?;
+                }
+                objects.push(object);
+            }
         }
         for (i, keys) in self.plane.into_iter().enumerate() {
             let at = format!("[[plane]] number {}", i + 1);
@@ -856,6 +888,16 @@ fn least_length(size: f64, ratio: f64) -> f64 {
     (ratio * size).max(MIN_RADIUS)
 }
 
+/// Text made only when it is shown: where a generated sphere is, named in a
+/// message only if it is refused.
+struct Lazy<F: Fn() -> String>(F);
+
+impl<F: Fn() -> String> std::fmt::Display for Lazy<F> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&(self.0)())
+    }
+}
+
 /// Refuse a sphere too small for its place in the scene, and a camera or a light
 /// inside (or on) it.
 ///
@@ -869,7 +911,13 @@ fn least_length(size: f64, ratio: f64) -> f64 {
 ///   sees only the wall, lit as if from outside, and a light inside would leave
 ///   every other point in the sphere's shadow. "On" allows for rounding: within
 ///   `ratio` of the scene's size of the surface.
-fn placed(s: &Sphere, at: &str, camera: Vec3, light: Vec3, ratio: f64) -> Result<(), String> {
+fn placed(
+    s: &Sphere,
+    at: &dyn std::fmt::Display,
+    camera: Vec3,
+    light: Vec3,
+    ratio: f64,
+) -> Result<(), String> {
     let size = s.center.abs().max_element().max(camera.abs().max_element());
     let smallest = least_length(size, ratio);
     if s.radius < smallest {
@@ -891,23 +939,27 @@ fn placed(s: &Sphere, at: &str, camera: Vec3, light: Vec3, ratio: f64) -> Result
     }
     let margin = ratio * size.max(s.radius);
     let inside = |p: Vec3| (p - s.center).length() <= s.radius + margin;
-    let described = format!(
-        "{at} (center {}, radius {})",
-        vector(s.center),
-        shown(s.radius)
-    );
+    let described = || {
+        format!(
+            "{at} (center {}, radius {})",
+            vector(s.center),
+            shown(s.radius)
+        )
+    };
     if inside(camera) {
         return Err(format!(
-            "camera.position {} is inside {described}: the camera would see only the \
+            "camera.position {} is inside {}: the camera would see only the \
              inside of that sphere's wall; move the camera or the sphere",
-            vector(camera)
+            vector(camera),
+            described()
         ));
     }
     if inside(light) {
         return Err(format!(
-            "light.position {} is inside {described}: no light could leave it, so every \
+            "light.position {} is inside {}: no light could leave it, so every \
              other point would be in shadow; move the light or the sphere",
-            vector(light)
+            vector(light),
+            described()
         ));
     }
     Ok(())

@@ -46,7 +46,8 @@ Limits (a value beyond them is refused with a message, exit code 2):
   numbers        finite, at most 1e15 in magnitude; a radius at least 1e-12 and
                  1.9e-15 of the scene's size (1e-6 with --precision f32)
   scene files    at most 16 MiB
-  generate       at most 100,000 spheres
+  generate       at most 1,000,000 spheres, listed up to 100,000 and above
+                 written as a recipe ([generate] spheres = N, at most 1,000,000)
   chart --scale  a --max-count whose largest scene fits in 2.1 GB: about 750
                  bytes per sphere and 64 per pixel
 Exit codes: 0 done, 1 diff found the images different, 2 a mistake in the input
@@ -160,13 +161,19 @@ pub struct GenerateArgs {
 pub enum Generated {
     /// N spheres resting on the floor, at 1920 × 1080; the radius shrinks as 1/√N.
     Spheres {
-        /// How many spheres (1 to 100,000: a scene file of 100,000 is 12 MB, near
-        /// the 16 MiB a scene file may be).
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+        /// How many spheres, 1 to 1,000,000. Up to 100,000 the scene file lists
+        /// them (a file of 100,000 is 16 MB, near the 16 MiB a scene file may be);
+        /// above, it holds their recipe, the scene file's generate section.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
         count: u32,
-        /// The seed of the random numbers: the same seed, the same scene.
-        #[arg(long, default_value_t = 1)]
+        /// The seed of the random numbers, 0 to 9223372036854775807 (TOML's largest
+        /// integer): the same seed, the same scene.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(0..=i64::MAX as u64))]
         seed: u64,
+        /// Write the recipe (the generate section: spheres = N, seed = S) at any
+        /// count, not the list: a small file that loads in a fraction of the time.
+        #[arg(long)]
+        recipe: bool,
     },
 }
 

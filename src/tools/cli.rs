@@ -140,8 +140,24 @@ pub fn execute(cli: Cli) -> Result<u8, Error> {
         Some(Command::Chart(args)) => chart(args),
         Some(Command::Serve(args)) => crate::tools::serve::run(&args),
         Some(Command::Generate(args)) => match args.what {
-            Generated::Spheres { count, seed } => {
-                let text = crate::tools::generate::spheres_toml(count as usize, seed);
+            Generated::Spheres {
+                count,
+                seed,
+                recipe,
+            } => {
+                use crate::tools::generate::{recipe_toml, spheres_toml, MAX_LISTED};
+                let count = count as usize;
+                let text = if recipe || count > MAX_LISTED {
+                    if !recipe {
+                        status!(
+                            "more than {MAX_LISTED} spheres: the scene holds their recipe, \
+                             [generate] spheres = {count}, seed = {seed}, not their list"
+                        );
+                    }
+                    recipe_toml(count, seed)
+                } else {
+                    spheres_toml(count, seed)
+                };
                 write_stdout(text.as_bytes())
             }
         },

@@ -1,77 +1,39 @@
 //! `raystep generate spheres`: scenes of many spheres, to see how the cost grows
-//! with the scene.
+//! with the scene. The spheres are made in `src/io/generated.rs`; this writes
+//! the scene file.
 //!
-//! N spheres rest on the tutorial's floor, spread evenly at random over a patch of
-//! 10 × 12 units in front of the camera; their radius shrinks as 1/√N so that the
-//! patch looks about as full at every N. Colours and mirror weights are random.
-//! The same count and seed give the same scene, byte for byte: the numbers come
-//! from SplitMix64 and are rounded to 5 decimals before use, so the TOML text
-//! holds them exactly.
+//! A scene file lists its spheres up to [`MAX_LISTED`]; a larger one holds the
+//! recipe instead, a `[generate]` section (`spheres = N`, `seed = S`) that the
+//! scene loader turns into the same spheres with [`objects`]. A list of a million
+//! spheres would be a 120 MB file, which the TOML reader would take seconds and
+//! gigabytes to read.
 
 use std::fmt::Write;
 
-use crate::samples::{splitmix64, unit_interval};
-use crate::scene::{Material, Object, Role, Scene, Shape};
-use crate::sphere::Sphere;
-use crate::Vec3;
+pub use crate::io::generated::{objects, spheres, Ball, MAX_GENERATED};
+use crate::scene::Scene;
 
-/// A sphere of a generated scene.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Ball {
-    /// Centre.
-    pub center: [f64; 3],
-    /// Radius.
-    pub radius: f64,
-    /// Ambient colour: a tenth of the diffuse one.
-    pub ambient: [f64; 3],
-    /// Diffuse colour.
-    pub diffuse: [f64; 3],
-    /// Mirror weight.
-    pub reflection: f64,
-}
+/// The most spheres a generated scene file lists one by one (a 16 MB file, near the
+/// 16 MiB a scene file may be; reading it takes the TOML reader 0.7–0.9 s and
+/// 530 MB); above, it holds the recipe.
+pub const MAX_LISTED: usize = 100_000;
 
-/// Height of the floor's top (the tutorial's floor sphere: −9000 + 8999.3).
-const FLOOR: f64 = -0.7;
-
-/// N spheres from `seed`.
-pub fn spheres(count: usize, seed: u64) -> Vec<Ball> {
-    let mut state = splitmix64(seed);
-    let mut next = move || {
-        state = splitmix64(state);
-        unit_interval(state)
-    };
-    let round = |x: f64| (x * 1e5).round() / 1e5;
-    let (width, depth) = (10.0, 12.0);
-    let spacing = (width * depth / count.max(1) as f64).sqrt();
-    let largest = (0.3 * spacing).clamp(0.002, 0.5);
-    (0..count)
-        .map(|_| {
-            let radius = round(largest * (0.6 + 0.4 * next())).max(1e-5);
-            let x = round((next() - 0.5) * width);
-            let z = round(-1.0 - next() * depth);
-            let diffuse = [(); 3].map(|_| round(0.2 + 0.7 * next()));
-            Ball {
-                center: [x, round(FLOOR + radius), z],
-                radius,
-                ambient: diffuse.map(|c| (c * 1e6).round() / 1e7),
-                diffuse,
-                reflection: round(0.5 * next()),
-            }
-        })
-        .collect()
-}
-
-/// The scene file of N spheres from `seed`, at 1920 × 1080.
-pub fn spheres_toml(count: usize, seed: u64) -> String {
-    let mut text = String::with_capacity(200 + count * 120);
-    let _ = writeln!(
-        text,
+/// The camera, light and floor of every generated scene, with the comment that
+/// names the command.
+fn header(count: usize, seed: u64) -> String {
+    format!(
         "# {count} spheres over the floor: raystep generate spheres --count {count} --seed {seed}\n\
          \n[image]\nwidth = 1920\nheight = 1080\n\n[camera]\nposition = [0, 0.2, 1]\n\n\
          [light]\nposition = [5, 5, 5]\n\n[render]\nmax_depth = 3\n\n\
          [[plane]]\nsphere = {{ center = [0, -9000, 0], radius = 8999.3 }}\n\
          ambient = [0.1, 0.1, 0.1]\ndiffuse = [0.6, 0.6, 0.6]\n"
-    );
+    )
+}
+
+/// The scene file of N spheres from `seed`, at 1920 × 1080, each sphere listed.
+pub fn spheres_toml(count: usize, seed: u64) -> String {
+    let mut text = String::with_capacity(200 + count * 120);
+    text.push_str(&header(count, seed));
     for b in spheres(count, seed) {
         let [x, y, z] = b.center;
         let [ar, ag, ab] = b.ambient;
@@ -86,29 +48,24 @@ pub fn spheres_toml(count: usize, seed: u64) -> String {
     text
 }
 
-/// The scene of [`spheres_toml`], built directly (a million spheres would make a
-/// scene file of 150 MB, beyond what the loader reads).
+/// The same scene as [`spheres_toml`], as its recipe: the header and a
+/// `[generate]` section, whatever the count.
+pub fn recipe_toml(count: usize, seed: u64) -> String {
+    format!(
+        "{}\n# The spheres are not listed: the loader makes them from this recipe, as\n\
+         # `raystep generate spheres` would list them (it lists up to {MAX_LISTED}).\n\
+         [generate]\nspheres = {count}\nseed = {seed}\n",
+        header(count, seed)
+    )
+}
+
+/// The scene of [`spheres_toml`], built directly, at any count (`chart --scale`
+/// goes past the [`MAX_GENERATED`] a scene file's recipe may ask for).
 pub fn scene(count: usize, seed: u64) -> Scene {
     let mut scene = crate::io::scene_file::parse(&spheres_toml(0, seed), "generated")
         .expect("the generated header is a valid scene");
     let floor = scene.objects.pop().expect("the header has the floor");
-    scene.objects = spheres(count, seed)
-        .into_iter()
-        .map(|b| Object {
-            shape: Shape::Sphere(Sphere {
-                center: Vec3::from(b.center),
-                radius: b.radius,
-            }),
-            material: Material {
-                ambient: Vec3::from(b.ambient),
-                diffuse: Vec3::from(b.diffuse),
-                specular: floor.material.specular,
-                shininess: floor.material.shininess,
-                reflection: b.reflection,
-            },
-            role: Role::Sphere,
-        })
-        .collect();
+    scene.objects = objects(count, seed).collect();
     scene.objects.push(floor);
     scene
 }
@@ -118,12 +75,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_same_seed_gives_the_same_spheres_and_another_seed_others() {
-        assert_eq!(spheres(100, 7), spheres(100, 7));
-        assert_ne!(spheres(100, 7), spheres(100, 8));
-    }
-
-    #[test]
     fn the_scene_file_and_the_scene_built_directly_agree() {
         let text = spheres_toml(200, 3);
         let parsed = crate::io::scene_file::parse(&text, "generated").unwrap();
@@ -131,11 +82,11 @@ mod tests {
     }
 
     #[test]
-    fn spheres_rest_on_the_floor_inside_the_patch() {
-        for b in spheres(1000, 1) {
-            assert!((b.center[1] - b.radius - FLOOR).abs() < 1e-5, "{b:?}");
-            assert!(b.center[0].abs() <= 5.0 && (-13.0..=-1.0).contains(&b.center[2]));
-            assert!(b.radius > 0.0 && b.radius <= 0.5);
-        }
+    fn the_recipe_makes_the_spheres_the_list_lists() {
+        let listed = crate::io::scene_file::parse(&spheres_toml(300, 11), "list").unwrap();
+        let made = crate::io::scene_file::parse(&recipe_toml(300, 11), "recipe").unwrap();
+        assert_eq!(made.objects.len(), 301);
+        assert_eq!(made, listed);
+        assert_ne!(made, scene(300, 12));
     }
 }

@@ -1,0 +1,104 @@
+//! The spheres of a generated scene: what `raystep generate spheres` lists and
+//! what a scene file's `[generate]` recipe makes (`src/tools/generate.rs` writes
+//! the files).
+//!
+//! N spheres rest on the tutorial's floor, spread evenly at random over a patch of
+//! 10 × 12 units in front of the camera; their radius shrinks as 1/√N so that the
+//! patch looks about as full at every N. Colours and mirror weights are random.
+//! The numbers come from SplitMix64 and are rounded to 5 decimals before use, so
+//! a scene file's text holds them exactly and the same count and seed give the
+//! same spheres, listed or made from the recipe.
+
+use crate::samples::{splitmix64, unit_interval};
+use crate::scene::{Material, Object, Role, Shape};
+use crate::sphere::Sphere;
+use crate::Vec3;
+
+/// The most spheres a recipe (`[generate] spheres = N`) may make.
+pub const MAX_GENERATED: usize = 1_000_000;
+
+/// A sphere of a generated scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ball {
+    /// Centre.
+    pub center: [f64; 3],
+    /// Radius.
+    pub radius: f64,
+    /// Ambient colour: a tenth of the diffuse one.
+    pub ambient: [f64; 3],
+    /// Diffuse colour.
+    pub diffuse: [f64; 3],
+    /// Mirror weight.
+    pub reflection: f64,
+}
+
+/// Height of the floor's top (the tutorial's floor sphere: −9000 + 8999.3).
+const FLOOR: f64 = -0.7;
+
+/// N spheres from `seed`.
+pub fn spheres(count: usize, seed: u64) -> Vec<Ball> {
+    let mut state = splitmix64(seed);
+    let mut next = move || {
+        state = splitmix64(state);
+        unit_interval(state)
+    };
+    let round = |x: f64| (x * 1e5).round() / 1e5;
+    let (width, depth) = (10.0, 12.0);
+    let spacing = (width * depth / count.max(1) as f64).sqrt();
+    let largest = (0.3 * spacing).clamp(0.002, 0.5);
+    (0..count)
+        .map(|_| {
+            let radius = round(largest * (0.6 + 0.4 * next())).max(1e-5);
+            let x = round((next() - 0.5) * width);
+            let z = round(-1.0 - next() * depth);
+            let diffuse = [(); 3].map(|_| round(0.2 + 0.7 * next()));
+            Ball {
+                center: [x, round(FLOOR + radius), z],
+                radius,
+                ambient: diffuse.map(|c| (c * 1e6).round() / 1e7),
+                diffuse,
+                reflection: round(0.5 * next()),
+            }
+        })
+        .collect()
+}
+
+/// The spheres of [`spheres`] as the scene's objects, with a sphere's default
+/// specular colour and shininess: what the scene file's listed `[[sphere]]`
+/// entries, or its `[generate]` recipe, are read into.
+pub fn objects(count: usize, seed: u64) -> impl Iterator<Item = Object> {
+    spheres(count, seed).into_iter().map(|b| Object {
+        shape: Shape::Sphere(Sphere {
+            center: Vec3::from(b.center),
+            radius: b.radius,
+        }),
+        material: Material {
+            ambient: Vec3::from(b.ambient),
+            diffuse: Vec3::from(b.diffuse),
+            specular: Vec3::ONE,
+            shininess: 100.0,
+            reflection: b.reflection,
+        },
+        role: Role::Sphere,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_same_seed_gives_the_same_spheres_and_another_seed_others() {
+        assert_eq!(spheres(100, 7), spheres(100, 7));
+        assert_ne!(spheres(100, 7), spheres(100, 8));
+    }
+
+    #[test]
+    fn spheres_rest_on_the_floor_inside_the_patch() {
+        for b in spheres(1000, 1) {
+            assert!((b.center[1] - b.radius - FLOOR).abs() < 1e-5, "{b:?}");
+            assert!(b.center[0].abs() <= 5.0 && (-13.0..=-1.0).contains(&b.center[2]));
+            assert!(b.radius > 0.0 && b.radius <= 0.5);
+        }
+    }
+}
