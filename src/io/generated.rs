@@ -1,6 +1,6 @@
 //! The spheres of a generated scene: what `raystep generate spheres` lists and
 //! what a scene file's `[generate]` recipe makes (`src/tools/generate.rs` writes
-//! the files).
+//! the files; `scene_file::generated_objects` makes them the scene's objects).
 //!
 //! N spheres rest on the tutorial's floor, spread evenly at random over a patch of
 //! 10 × 12 units in front of the camera; their radius shrinks as 1/√N so that the
@@ -10,9 +10,6 @@
 //! same spheres, listed or made from the recipe.
 
 use crate::samples::{splitmix64, unit_interval};
-use crate::scene::{Material, Object, Role, Shape};
-use crate::sphere::Sphere;
-use crate::Vec3;
 
 /// The most spheres a recipe (`[generate] spheres = N`) may make.
 pub const MAX_GENERATED: usize = 1_000_000;
@@ -61,26 +58,6 @@ pub fn spheres(count: usize, seed: u64) -> Vec<Ball> {
             }
         })
         .collect()
-}
-
-/// The spheres of [`spheres`] as the scene's objects, with a sphere's default
-/// specular colour and shininess: what the scene file's listed `[[sphere]]`
-/// entries, or its `[generate]` recipe, are read into.
-pub fn objects(count: usize, seed: u64) -> impl Iterator<Item = Object> {
-    spheres(count, seed).into_iter().map(|b| Object {
-        shape: Shape::Sphere(Sphere {
-            center: Vec3::from(b.center),
-            radius: b.radius,
-        }),
-        material: Material {
-            ambient: Vec3::from(b.ambient),
-            diffuse: Vec3::from(b.diffuse),
-            specular: Vec3::ONE,
-            shininess: 100.0,
-            reflection: b.reflection,
-        },
-        role: Role::Sphere,
-    })
 }
 
 #[cfg(test)]

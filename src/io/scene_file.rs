@@ -690,8 +690,7 @@ impl SceneFile {
                 ));
             }
             let seed = keys.seed.unwrap_or(1);
-            let made = crate::io::generated::objects(count, seed);
-            for (i, object) in made.enumerate() {
+            for (i, object) in generated_objects(count, seed).enumerate() {
                 if let Shape::Sphere(shape) = &object.shape {
                     let at = Lazy(|| format!("[generate] sphere number {} (seed {seed})", i + 1));
                     placed(shape, &at, camera, light.position, MIN_RADIUS_RATIO_F64)?;
@@ -798,6 +797,38 @@ impl PlaneKeys {
             )),
         }
     }
+}
+
+/// The spheres of `raystep generate spheres --count N --seed S` as the scene's
+/// objects: their colours and mirror weights, and a sphere's defaults for the
+/// keys the generated scene leaves out (what its listed `[[sphere]]` entries are
+/// read into, and what a `[generate]` recipe makes).
+pub fn generated_objects(count: usize, seed: u64) -> impl Iterator<Item = Object> {
+    let defaults = MaterialKeys {
+        ambient: None,
+        diffuse: None,
+        specular: None,
+        shininess: None,
+        reflection: None,
+    }
+    .check("a generated sphere")
+    .expect("a sphere's default material is valid");
+    crate::io::generated::spheres(count, seed)
+        .into_iter()
+        .map(move |b| Object {
+            shape: Shape::Sphere(Sphere {
+                center: Vec3::from(b.center),
+                radius: b.radius,
+            }),
+            material: Material {
+                ambient: Vec3::from(b.ambient),
+                diffuse: Vec3::from(b.diffuse),
+                specular: defaults.specular,
+                shininess: defaults.shininess,
+                reflection: b.reflection,
+            },
+            role: Role::Sphere,
+        })
 }
 
 impl MaterialKeys {

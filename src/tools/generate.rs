@@ -10,7 +10,8 @@
 
 use std::fmt::Write;
 
-pub use crate::io::generated::{objects, spheres, Ball, MAX_GENERATED};
+pub use crate::io::generated::{spheres, Ball, MAX_GENERATED};
+pub use crate::io::scene_file::generated_objects as objects;
 use crate::scene::Scene;
 
 /// The most spheres a generated scene file lists one by one (a 16 MB file, near the
