@@ -450,7 +450,11 @@ fn chapter_1_quotes_what_check_prints() {
     let scene = raystep::io::scene_file::load(&root().join("scenes/seed.toml")).unwrap();
     assert_quotes(
         "01",
-        &raystep::tools::cli::describe(&scene, "scenes/seed.toml"),
+        &raystep::tools::cli::describe(
+            &scene,
+            "scenes/seed.toml",
+            Some(raystep::tools::cli::LISTED),
+        ),
     );
 }
 

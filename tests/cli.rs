@@ -158,6 +158,42 @@ fn check_describes_the_scene() {
 }
 
 #[test]
+fn check_counts_the_spheres_past_the_first_twenty() {
+    // A generated scene of 30: the report in words lists 20 and counts 10; --all
+    // and --json list all 30 (a scene of a million would otherwise print two
+    // million lines).
+    let dir = tempfile::tempdir().unwrap();
+    let out = raystep(
+        dir.path(),
+        &["generate", "spheres", "--count", "30", "--seed", "3"],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    std::fs::write(dir.path().join("thirty.toml"), &out.stdout).unwrap();
+    let listed = |stdout: &str| {
+        stdout
+            .lines()
+            .filter(|l| l.trim_start().split_once(". sphere at").is_some())
+            .count()
+    };
+    let short = text(&raystep(dir.path(), &["check", "thirty.toml"]).stdout);
+    assert!(short.contains("spheres: 30"), "{short}");
+    assert!(short.contains("    20. sphere at"), "{short}");
+    assert!(!short.contains("    21. sphere at"), "{short}");
+    assert!(
+        short.contains("… and 10 more (raystep check --all"),
+        "{short}"
+    );
+    // The floor is the one plane, listed after the count of the spheres.
+    assert_eq!(listed(&short), 21, "{short}");
+    let all = text(&raystep(dir.path(), &["check", "thirty.toml", "--all"]).stdout);
+    assert_eq!(listed(&all), 31, "{all}");
+    assert!(!all.contains("more (raystep check --all"), "{all}");
+    let json = raystep(dir.path(), &["check", "thirty.toml", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    assert_eq!(v["objects"].as_array().unwrap().len(), 31);
+}
+
+#[test]
 fn help_and_version_work() {
     let dir = tempfile::tempdir().unwrap();
     let out = raystep(dir.path(), &["--version"]);

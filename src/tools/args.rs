@@ -361,9 +361,14 @@ pub struct RenderArgs {
 pub struct CheckArgs {
     /// Scene file (TOML) to check; - reads it from standard input.
     pub scene: PathBuf,
-    /// Print one JSON object instead of the report in words.
+    /// Print one JSON object instead of the report in words (it lists every
+    /// object).
     #[arg(long)]
     pub json: bool,
+    /// List every sphere in words, not only the first 20 of each kind and a count
+    /// of the rest.
+    #[arg(long)]
+    pub all: bool,
 }
 
 /// Arguments of `raystep diff`.

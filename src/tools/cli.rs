@@ -723,7 +723,8 @@ fn check(args: &CheckArgs) -> Result<(), Error> {
     if args.json {
         return say_json(describe_json(&scene, &name), true);
     }
-    say!("{}", describe(&scene, &name).trim_end());
+    let listed = (!args.all).then_some(LISTED);
+    say!("{}", describe(&scene, &name, listed).trim_end());
     Ok(())
 }
 
@@ -793,8 +794,14 @@ pub fn describe_json(scene: &Scene, name: &str) -> serde_json::Value {
     })
 }
 
-/// A readable summary of a checked scene, as `raystep check` prints it.
-pub fn describe(scene: &Scene, name: &str) -> String {
+/// How many spheres (and planes) `raystep check` lists in words before it counts
+/// the rest: a generated scene of a million would print two million lines.
+pub const LISTED: usize = 20;
+
+/// A readable summary of a checked scene, as `raystep check` prints it: every
+/// object, or with `listed = Some(n)` the first `n` of each kind and a line that
+/// counts the others.
+pub fn describe(scene: &Scene, name: &str, listed: Option<usize>) -> String {
     let mut out = format!("{name}: a valid scene\n");
     let cam = scene.camera();
     let s = cam.screen;
@@ -828,7 +835,8 @@ pub fn describe(scene: &Scene, name: &str) -> String {
             _ => "",
         };
         out += &format!("  {heading} {}{note}\n", objects.len());
-        for (i, o) in objects.iter().enumerate() {
+        let shown = listed.unwrap_or(usize::MAX).min(objects.len());
+        for (i, o) in objects.iter().enumerate().take(shown) {
             let shape = match o.shape {
                 Shape::Sphere(sp) => format!("sphere at {}, radius {}", sp.center, sp.radius),
                 Shape::Plane(p) => format!("true plane through {}, normal {}", p.point, p.normal),
@@ -842,6 +850,12 @@ pub fn describe(scene: &Scene, name: &str) -> String {
                 m.specular,
                 m.shininess,
                 m.reflection
+            );
+        }
+        if shown < objects.len() {
+            out += &format!(
+                "    … and {} more (raystep check --all lists every one, --json too)\n",
+                objects.len() - shown
             );
         }
     }
