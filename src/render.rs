@@ -449,6 +449,11 @@ pub trait Progress: Sync {
     fn cancelled(&self) -> bool {
         false
     }
+    /// The engine is set up (its objects converted, its tree built): the rows
+    /// start now. (`raystep bench` times the rows apart from the set-up.)
+    fn rows_begin(&self) {}
+    /// The last row is finished.
+    fn rows_end(&self) {}
 }
 
 impl<F: Fn(u64) + Sync> Progress for F {
@@ -496,7 +501,8 @@ pub fn in_rows(
     progress: &dyn Progress,
     row: impl Fn(u32, &mut [PixelRecord]) -> Rays + Sync,
 ) -> Rays {
-    frame
+    progress.rows_begin();
+    let rays = frame
         .pixels
         .par_chunks_mut(width)
         .enumerate()
@@ -511,7 +517,9 @@ pub fn in_rows(
         .reduce(Rays::default, |mut a, b| {
             a += b;
             a
-        })
+        });
+    progress.rows_end();
+    rays
 }
 
 // ANCHOR: row

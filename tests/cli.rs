@@ -351,6 +351,20 @@ fn bench_prints_one_json_object_with_the_promised_keys() {
         (Some(64), Some(36))
     );
     assert_eq!(json["rays_primary"].as_u64(), Some(64 * 36));
+    // The rows alone are part of every frame, so their median is no longer than
+    // the frame's, and the set-up (the rest) is what is left, never negative.
+    let seconds = |key: &str| {
+        json[key]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{key} in {json}"))
+    };
+    assert!(seconds("trace_s") > 0.0);
+    assert!(seconds("trace_s") <= seconds("median_s"), "{json}");
+    assert!(seconds("setup_s") >= 0.0, "{json}");
+    assert!(
+        seconds("trace_rays_per_s") >= seconds("rays_per_s"),
+        "{json}"
+    );
 }
 
 #[test]

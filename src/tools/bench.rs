@@ -6,9 +6,13 @@
 //! for, and the [yardstick](crate::tools::yardstick) (the tutorial's program ported
 //! plainly) with the same threads. Each is rendered once to warm up, then
 //! `runs` times; the median of the runs is reported. Only the render is timed:
-//! the frame is allocated once, before the runs, and no file is written.
+//! the frame is allocated once, before the runs, and no file is written. Within
+//! each frame of the engine asked for, its rows are timed apart from the set-up
+//! before them (objects converted, BVH built), as a peer such as Embree times
+//! its frames without its tree's build.
 
 use std::cell::{Cell, RefCell};
+use std::sync::Mutex;
 use std::time::Instant;
 
 use serde::Serialize;
@@ -19,7 +23,7 @@ use crate::bvh::Bvh;
 use crate::engine::render_into;
 use crate::error::Error;
 use crate::real::Precision;
-use crate::render::Settings;
+use crate::render::{Progress, Settings};
 use crate::scene::{Role, Scene};
 use crate::sphere::Method;
 use crate::stages::Engine;
@@ -52,10 +56,24 @@ pub struct Report {
     pub rays_per_s: f64,
     /// `width · height / median_s`.
     pub pixels_per_s: f64,
+    /// Median seconds of the rows alone, from the first row's start to the last
+    /// row's end: the frame without the engine's set-up (objects converted, BVH
+    /// built) and what follows the rows. Embree's frames are timed so.
+    pub trace_s: f64,
+    /// `rays / trace_s`.
+    pub trace_rays_per_s: f64,
+    /// Median seconds of the set-up and what follows the rows: the frame's time
+    /// less its rows' time, run by run.
+    pub setup_s: f64,
     /// Median seconds per frame with one thread (absent when `threads` is 1).
     pub one_thread_median_s: Option<f64>,
     /// `one_thread_median_s / median_s`.
     pub thread_speedup: Option<f64>,
+    /// Median seconds of the rows alone with one thread (absent when `threads`
+    /// is 1).
+    pub one_thread_trace_s: Option<f64>,
+    /// `one_thread_trace_s / trace_s`: the rows' own speed-up.
+    pub trace_thread_speedup: Option<f64>,
     /// Median seconds per frame of the yardstick (absent for a scene with a true
     /// plane, which the tutorial's program cannot draw, or with `--no-yardstick`).
     pub yardstick_median_s: Option<f64>,
@@ -102,6 +120,39 @@ pub struct Options {
 /// A timed thing: a name for messages and a closure that renders one frame.
 type Job<'a> = Box<dyn FnMut() + 'a>;
 
+/// The progress of a timed render: it keeps when its rows began and ended, and
+/// adds the rows' seconds to `rows` at the end of each frame.
+#[derive(Default)]
+struct RowClock {
+    began: Mutex<Option<Instant>>,
+    rows: Mutex<Vec<f64>>,
+}
+
+impl Progress for RowClock {
+    fn row_done(&self) {}
+    fn rows_begin(&self) {
+        *self.began.lock().expect("a clock is never poisoned") = Some(Instant::now());
+    }
+    fn rows_end(&self) {
+        let began = self.began.lock().expect("a clock is never poisoned").take();
+        if let Some(began) = began {
+            let seconds = began.elapsed().as_secs_f64();
+            self.rows
+                .lock()
+                .expect("a clock is never poisoned")
+                .push(seconds);
+        }
+    }
+}
+
+impl RowClock {
+    /// The rows' seconds of every frame but the first (the warm-up).
+    fn timed(self) -> Vec<f64> {
+        let rows = self.rows.into_inner().expect("a clock is never poisoned");
+        rows.into_iter().skip(1).collect()
+    }
+}
+
 /// Bench `scene` under `settings`. `progress(1)` is called after every run.
 pub fn bench(
     scene: &Scene,
@@ -140,8 +191,9 @@ pub fn bench(
     let fast_packets = Cell::new(Packets::Off);
     let (mut image, mut yardstick_rays) = (Vec::new(), Vec::new());
     let yardstick_total = Cell::new(0);
+    let (clock, one_clock) = (RowClock::default(), RowClock::default());
     let mut jobs: Vec<Job> = vec![
-        Box::new(|| many.install(|| render_into(scene, settings, &mut frame, &|_| {}))),
+        Box::new(|| many.install(|| render_into(scene, settings, &mut frame, &clock))),
         Box::new(|| {
             let mut guard = spare.borrow_mut();
             let spare: &mut Frame = &mut guard;
@@ -155,7 +207,7 @@ pub fn bench(
         jobs.push(Box::new(|| {
             let mut guard = spare.borrow_mut();
             let spare: &mut Frame = &mut guard;
-            one.install(|| render_into(scene, settings, spare, &|_| {}))
+            one.install(|| render_into(scene, settings, spare, &one_clock))
         }));
     }
     if let Some(y) = &yardstick {
@@ -193,6 +245,11 @@ pub fn bench(
         Engine::Book => fast_packets.get(),
     };
 
+    // The rows' times, and the rest of each frame run by run.
+    let (rows, one_rows) = (clock.timed(), one_clock.timed());
+    let setup_s = median(seconds[0].iter().zip(&rows).map(|(f, r)| f - r).collect());
+    let trace_s = median(rows);
+    let one_thread_trace_s = (options.threads > 1).then(|| median(one_rows));
     let mut medians = seconds.into_iter().map(median);
     let median_s = medians.next().expect("raystep is always timed");
     let other_median_s = medians.next().expect("both engines are always timed");
@@ -213,8 +270,13 @@ pub fn bench(
         rays_reflection: rays.reflection,
         rays_per_s: rays.total() as f64 / median_s,
         pixels_per_s: pixels / median_s,
+        trace_s,
+        trace_rays_per_s: rays.total() as f64 / trace_s,
+        setup_s,
         one_thread_median_s,
         thread_speedup: one_thread_median_s.map(|t| t / median_s),
+        one_thread_trace_s,
+        trace_thread_speedup: one_thread_trace_s.map(|t| t / trace_s),
         yardstick_median_s,
         yardstick_rays: yardstick_median_s.map(|_| yardstick_total.get()),
         yardstick_rays_per_s: yardstick_median_s.map(|t| yardstick_total.get() as f64 / t),
@@ -291,6 +353,12 @@ impl Report {
             self.rays_per_s / 1e6
         ));
         line(format!(
+            "  rows alone  {:>9.4} s per frame   {:>7.1} Mray/s   (set-up and the rest {:.4} s)",
+            self.trace_s,
+            self.trace_rays_per_s / 1e6,
+            self.setup_s
+        ));
+        line(format!(
             "  rays        {:>9} per frame: {} primary, {} shadow, {} reflection",
             self.rays, self.rays_primary, self.rays_shadow, self.rays_reflection
         ));
@@ -310,6 +378,12 @@ impl Report {
                 "  1 thread    {t:>9.4} s per frame   {} threads are {s:.2}× faster",
                 self.threads
             ));
+            if let (Some(t), Some(s)) = (self.one_thread_trace_s, self.trace_thread_speedup) {
+                line(format!(
+                    "  1 thread    {t:>9.4} s of rows      {} threads are {s:.2}× faster on the rows",
+                    self.threads
+                ));
+            }
         }
         line(format!(
             "  {:<11} {:>9.4} s per frame   {:>7.1} Mpixel/s",
