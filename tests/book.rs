@@ -520,7 +520,7 @@ fn the_charts_shown_exist_and_their_numbers_are_the_csv_files() {
     }
     for command in [
         "raystep chart --runs 15 --out chapters/charts",
-        "raystep chart --scale --runs 3 --out chapters/charts",
+        "raystep chart --scale --runs 7 --out chapters/charts",
     ] {
         assert!(text.contains(command), "chapter 10 shows `{command}`");
     }
@@ -582,10 +582,17 @@ fn chapter_10_quotes_the_charts_csv_files() {
     assert!(text.contains(&quoted), "chapter 10 should say {quoted:?}");
     for quoted in [
         format!("tree of a million spheres is {:.0} MB", million[2] / 1e6),
-        format!("building it takes {:.0} ms", million[1]),
+        format!(
+            "building it takes {:.0} ms, a third of that frame",
+            million[1]
+        ),
     ] {
         assert!(text.contains(&quoted), "chapter 10 should say {quoted:?}");
     }
+    let third = million[1] / million[0];
+    assert!((0.28..0.4).contains(&third), "a third: {third}");
+    // The rays alone (the last column) are part of every frame.
+    assert!(ten[3] <= ten[0] && many[3] <= many[0] && million[3] <= million[0]);
     // "a little more than the number of paths a pixel traces (N + 1)".
     let ms = |setting| chart_value(setting, 1);
     for (setting, n) in [("spp 4", 4.0), ("spp 16", 16.0)] {

@@ -123,7 +123,7 @@ type Job<'a> = Box<dyn FnMut() + 'a>;
 /// The progress of a timed render: it keeps when its rows began and ended, and
 /// adds the rows' seconds to `rows` at the end of each frame.
 #[derive(Default)]
-struct RowClock {
+pub(crate) struct RowClock {
     began: Mutex<Option<Instant>>,
     rows: Mutex<Vec<f64>>,
 }
@@ -147,7 +147,7 @@ impl Progress for RowClock {
 
 impl RowClock {
     /// The rows' seconds of every frame but the first (the warm-up).
-    fn timed(self) -> Vec<f64> {
+    pub(crate) fn timed(self) -> Vec<f64> {
         let rows = self.rows.into_inner().expect("a clock is never poisoned");
         rows.into_iter().skip(1).collect()
     }

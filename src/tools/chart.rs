@@ -37,7 +37,7 @@ use crate::shade::shadow::Offset;
 use crate::sphere::Method;
 use crate::stages::Engine;
 use crate::stages::Stages;
-use crate::tools::bench::median;
+use crate::tools::bench::{median, RowClock};
 
 /// The font of the PNG charts, built in so that no system font is needed
 /// (DejaVu Sans; its licence is in `assets/DejaVuSans-LICENSE.txt`).
@@ -303,6 +303,9 @@ pub struct ScalePoint {
     /// Median seconds per frame (render only; raystep's includes its BVH build,
     /// Embree's does not).
     pub median_s: f64,
+    /// Median seconds of the frame without building the tree: raystep's rows
+    /// alone (as `raystep bench` times them, `trace_s`), Embree's frame.
+    pub trace_s: f64,
     /// Seconds to build the BVH alone (0 without one).
     pub build_s: f64,
     /// Bytes of the BVH (raystep's; 0 without one, and for Embree).
@@ -340,9 +343,10 @@ pub fn scale(
             };
             let mut frame = Frame::blank(scene.camera(), settings.precision);
             let mut times = Vec::new();
+            let clock = RowClock::default();
             for run in 0..=runs {
                 let start = Instant::now();
-                render_into(&scene, &settings, &mut frame, &|_| {});
+                render_into(&scene, &settings, &mut frame, &clock);
                 if run > 0 {
                     times.push(start.elapsed().as_secs_f64());
                 }
@@ -353,6 +357,7 @@ pub fn scale(
                 count,
                 series: Series::Raystep(accel),
                 median_s: median(times),
+                trace_s: median(clock.timed()),
                 build_s: if uses_bvh { build_s } else { 0.0 },
                 bvh_bytes: if uses_bvh { bvh.bytes() } else { 0 },
             });
@@ -363,6 +368,7 @@ pub fn scale(
                 count,
                 series: Series::Embree,
                 median_s,
+                trace_s: median_s,
                 build_s,
                 bvh_bytes: 0,
             });
@@ -430,7 +436,14 @@ fn run_embree(
 /// The scale points as CSV.
 pub fn scale_csv(points: &[ScalePoint]) -> String {
     csv_text(
-        &["spheres", "accel", "median_ms", "bvh_build_ms", "bvh_bytes"],
+        &[
+            "spheres",
+            "accel",
+            "median_ms",
+            "bvh_build_ms",
+            "bvh_bytes",
+            "trace_ms",
+        ],
         points.iter().map(|p| {
             [
                 p.count.to_string(),
@@ -438,6 +451,7 @@ pub fn scale_csv(points: &[ScalePoint]) -> String {
                 format!("{:.3}", p.median_s * 1e3),
                 format!("{:.3}", p.build_s * 1e3),
                 p.bvh_bytes.to_string(),
+                format!("{:.3}", p.trace_s * 1e3),
             ]
         }),
     )
@@ -691,15 +705,35 @@ fn draw_scale<DB: DrawingBackend>(
             "spheres in the scene",
         ),
         (
-            log_range(points.iter().map(|p| p.median_s * 1e3)),
+            log_range(
+                points
+                    .iter()
+                    .flat_map(|p| [p.median_s * 1e3, p.trace_s * 1e3]),
+            ),
             "milliseconds per frame (median)",
         ),
         0,
     )?;
     let auto = format!(
-        "raystep --accel auto (BVH from {} spheres)",
+        "raystep --accel auto (BVH from {} spheres): the rays alone",
         crate::accel::BVH_FROM
     );
+    // raystep's whole frame, its tree's build and set-up included, dashed.
+    let whole: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|p| p.series == Series::Raystep(Accel::Auto))
+        .map(|p| (p.count as f64, p.median_s * 1e3))
+        .collect();
+    if !whole.is_empty() {
+        let colour = RGBColor(120, 150, 255);
+        chart
+            .draw_series(DashedLineSeries::new(whole, 6, 4, colour.stroke_width(2)))
+            .map_err(e)?
+            .label("raystep --accel auto: the whole frame, the BVH's build included")
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+    }
     for (series, colour, name) in [
         (Series::Raystep(Accel::Auto), BLUE, auto.as_str()),
         (
@@ -710,13 +744,13 @@ fn draw_scale<DB: DrawingBackend>(
         (
             Series::Embree,
             RGBColor(20, 140, 60),
-            "Embree 3, user-geometry spheres, 8-ray packets (build not counted)",
+            "Embree 3, user-geometry spheres, 8-ray packets (its build not counted)",
         ),
     ] {
         let series: Vec<(f64, f64)> = points
             .iter()
             .filter(|p| p.series == series)
-            .map(|p| (p.count as f64, p.median_s * 1e3))
+            .map(|p| (p.count as f64, p.trace_s * 1e3))
             .collect();
         if series.is_empty() {
             continue;
