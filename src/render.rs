@@ -494,8 +494,7 @@ fn render_in<T: Real>(
 /// fills one row's records and returns the rays they took, telling `progress` of
 /// each. After Ctrl-C, or once `progress` is cancelled, the rows left are skipped
 /// (and the frame is thrown away). Returns the rays of the whole frame. Both
-/// engines render through it. The threads take the rows in turn (see below); the
-/// records are the same in any order and on any number of threads.
+/// engines render through it.
 pub fn in_rows(
     frame: &mut Frame,
     width: usize,
@@ -503,19 +502,10 @@ pub fn in_rows(
     row: impl Fn(u32, &mut [PixelRecord]) -> Rays + Sync,
 ) -> Rays {
     progress.rows_begin();
-    // The rows dealt out in turn: with k threads, rows 0, k, 2k, … first, then
-    // 1, k + 1, …, so that rayon, which hands each thread a share of the list,
-    // gives the threads neighbouring rows rather than distant bands of the image.
-    // They then read the same parts of the scene at the same time, which matters
-    // when the scene is larger than the caches (at 100,000 spheres the rows take
-    // about a twentieth less time on two threads). Each row is traced on its own,
-    // so the order changes no record.
-    let mut lines: Vec<(usize, &mut [PixelRecord])> =
-        frame.pixels.chunks_mut(width).enumerate().collect();
-    let k = rayon::current_num_threads();
-    lines.sort_by_key(|&(r, _)| (r % k, r));
-    let rays = lines
-        .into_par_iter()
+    let rays = frame
+        .pixels
+        .par_chunks_mut(width)
+        .enumerate()
         .map(|(r, line)| {
             if crate::interrupt::requested() || progress.cancelled() {
                 return Rays::default();
