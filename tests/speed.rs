@@ -103,29 +103,9 @@ fn tile_masks_and_the_bvh_change_no_pixel_of_any_scene() {
     }
 }
 
-/// Every bit of every record, so that even a zero of the other sign is a difference.
-fn bits(frame: &Frame) -> Vec<[u32; 12]> {
-    frame
-        .pixels
-        .iter()
-        .map(|p| {
-            let f = |x: f32| x.to_bits();
-            [
-                f(p.colour[0]),
-                f(p.colour[1]),
-                f(p.colour[2]),
-                f(p.depth),
-                f(p.normal[0]),
-                f(p.normal[1]),
-                f(p.normal[2]),
-                f(p.shadow),
-                p.object,
-                f(p.diffuse) ^ f(p.specular).rotate_left(16),
-                p.bounces,
-                p.rays,
-            ]
-        })
-        .collect()
+/// Every bit of every record ([`common::record_bits`]).
+fn bits(frame: &Frame) -> Vec<[u32; 13]> {
+    frame.pixels.iter().map(common::record_bits).collect()
 }
 
 /// The settings the fast engine must agree with the book engine under: every

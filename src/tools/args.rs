@@ -365,7 +365,7 @@ pub struct CheckArgs {
     /// object).
     #[arg(long)]
     pub json: bool,
-    /// List every sphere in words, not only the first 20 of each kind and a count
+    /// List every object in words, not only the first 20 of each kind and a count
     /// of the rest.
     #[arg(long)]
     pub all: bool,

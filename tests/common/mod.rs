@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use raystep::aov::Frame;
+use raystep::aov::{Frame, PixelRecord};
 use raystep::scene::Scene;
 use raystep::stages::Stages;
 
@@ -231,4 +231,25 @@ pub fn check_screenshot(
         path.display(),
         colours.len()
     );
+}
+
+/// Every bit of a record, a word a field, so that even a zero of the other sign or
+/// a NaN (which `==` never finds equal) compares as the bits it is.
+pub fn record_bits(p: &PixelRecord) -> [u32; 13] {
+    let f = |x: f32| x.to_bits();
+    [
+        f(p.colour[0]),
+        f(p.colour[1]),
+        f(p.colour[2]),
+        f(p.depth),
+        f(p.normal[0]),
+        f(p.normal[1]),
+        f(p.normal[2]),
+        f(p.shadow),
+        p.object,
+        f(p.diffuse),
+        f(p.specular),
+        p.bounces,
+        p.rays,
+    ]
 }
