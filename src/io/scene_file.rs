@@ -1317,9 +1317,13 @@ mod tests {
     }
 
     #[test]
-    fn a_large_file_with_a_mistake_names_its_line() {
+    fn a_large_file_is_read_in_parts_and_a_mistake_in_it_named_at_its_line() {
         let mut text = file(14000);
         assert!(text.len() >= APART_FROM, "{} bytes", text.len());
+        // Read in parts, as it is large and fit for them: what it gives whole.
+        assert!(read_apart(&text, APART_PART).is_some());
+        let scene = parse(&text, "big.toml").map_err(|e| e.to_string());
+        assert_eq!(scene, whole(&text));
         let at = text.match_indices("[[sphere]]").nth(8000).unwrap().0;
         let line = text[..at].lines().count() + 3;
         text.insert_str(at, "[[sphere]]\ncenter = [0, 0, -3]\nradius = \"big\"\n");
