@@ -700,7 +700,7 @@ impl SceneFile {
         check_image_size(width, height)?;
         let (width, height) = (width.0, height.0);
 
-        let camera = point(self.camera.position, "camera.position")?;
+        let camera = point(self.camera.position, &"camera.position")?;
         if camera.z == 0.0 {
             return Err(
                 "camera.position: z = 0 puts the eye on the screen, which lies in the plane \
@@ -733,10 +733,10 @@ impl SceneFile {
         }
 
         let light = Light {
-            position: point(self.light.position, "light.position")?,
-            ambient: colour(self.light.ambient, Vec3::ONE, "light.ambient")?,
-            diffuse: colour(self.light.diffuse, Vec3::ONE, "light.diffuse")?,
-            specular: colour(self.light.specular, Vec3::ONE, "light.specular")?,
+            position: point(self.light.position, &"light.position")?,
+            ambient: colour(self.light.ambient, Vec3::ONE, &"light.ambient")?,
+            diffuse: colour(self.light.diffuse, Vec3::ONE, &"light.diffuse")?,
+            specular: colour(self.light.specular, Vec3::ONE, &"light.specular")?,
         };
 
         let max_depth = self.render.and_then(|r| r.max_depth).unwrap_or(3);
@@ -744,7 +744,9 @@ impl SceneFile {
 
         let mut objects = Vec::new();
         for (i, keys) in self.sphere.into_iter().enumerate() {
-            let at = format!("[[sphere]] number {}", i + 1);
+            // Its place, written out only in a message (100,000 spheres would
+            // otherwise make as many strings, and five more each for its keys).
+            let at = Lazy(|| format!("[[sphere]] number {}", i + 1));
             let shape = sphere(keys.center, keys.radius, &at)?;
             placed(&shape, &at, camera, light.position, MIN_RADIUS_RATIO_F64)?;
             objects.push(Object {
@@ -809,10 +811,10 @@ impl ScreenKeys {
     fn check(self, width: u32, height: u32) -> Result<Screen, String> {
         let d = Screen::for_image(width, height);
         let s = Screen {
-            left: number(self.left.unwrap_or(d.left), "screen.left")?,
-            right: number(self.right.unwrap_or(d.right), "screen.right")?,
-            top: number(self.top.unwrap_or(d.top), "screen.top")?,
-            bottom: number(self.bottom.unwrap_or(d.bottom), "screen.bottom")?,
+            left: number(self.left.unwrap_or(d.left), &"screen.left")?,
+            right: number(self.right.unwrap_or(d.right), &"screen.right")?,
+            top: number(self.top.unwrap_or(d.top), &"screen.top")?,
+            bottom: number(self.bottom.unwrap_or(d.bottom), &"screen.bottom")?,
         };
         if s.left >= s.right {
             return Err(format!(
@@ -884,7 +886,7 @@ pub fn generated_objects(count: usize, seed: u64) -> impl Iterator<Item = Object
         shininess: None,
         reflection: None,
     }
-    .check("a generated sphere")
+    .check(&"a generated sphere")
     .expect("a sphere's default material is valid");
     crate::io::generated::spheres(count, seed)
         .into_iter()
@@ -905,8 +907,9 @@ pub fn generated_objects(count: usize, seed: u64) -> impl Iterator<Item = Object
 }
 
 impl MaterialKeys {
-    fn check(self, at: &str) -> Result<Material, String> {
-        let key = |name: &str| format!("{at}, {name}");
+    fn check(self, at: &dyn std::fmt::Display) -> Result<Material, String> {
+        // Each key's place, written out only in a message.
+        let key = |name: &'static str| Lazy(move || format!("{at}, {name}"));
         let shininess = number(self.shininess.unwrap_or(100.0), &key("shininess"))?;
         if shininess < 0.0 {
             return Err(format!(
@@ -933,7 +936,7 @@ impl MaterialKeys {
     }
 }
 
-fn number(value: f64, key: &str) -> Result<f64, String> {
+fn number(value: f64, key: &dyn std::fmt::Display) -> Result<f64, String> {
     if !value.is_finite() {
         Err(format!("{key}: {value} is not a finite number"))
     } else if value.abs() > MAX_MAGNITUDE {
@@ -946,14 +949,18 @@ fn number(value: f64, key: &str) -> Result<f64, String> {
     }
 }
 
-fn point(value: Triple, key: &str) -> Result<Vec3, String> {
+fn point(value: Triple, key: &dyn std::fmt::Display) -> Result<Vec3, String> {
     for v in value.0 {
         number(v, key)?;
     }
     Ok(Vec3::from(value.0))
 }
 
-fn colour(value: Option<Triple>, default: Vec3, key: &str) -> Result<Vec3, String> {
+fn colour(
+    value: Option<Triple>,
+    default: Vec3,
+    key: &dyn std::fmt::Display,
+) -> Result<Vec3, String> {
     let Some(value) = value else {
         return Ok(default);
     };
@@ -1187,8 +1194,8 @@ fn shown(v: f64) -> String {
     }
 }
 
-fn sphere(center: Triple, radius: f64, at: &str) -> Result<Sphere, String> {
-    let radius = number(radius, &format!("{at}, radius"))?;
+fn sphere(center: Triple, radius: f64, at: &dyn std::fmt::Display) -> Result<Sphere, String> {
+    let radius = number(radius, &Lazy(|| format!("{at}, radius")))?;
     if radius <= 0.0 {
         return Err(format!(
             "{at}, radius: {} must be greater than 0",
@@ -1196,7 +1203,7 @@ fn sphere(center: Triple, radius: f64, at: &str) -> Result<Sphere, String> {
         ));
     }
     Ok(Sphere {
-        center: point(center, &format!("{at}, center"))?,
+        center: point(center, &Lazy(|| format!("{at}, center")))?,
         radius,
     })
 }
