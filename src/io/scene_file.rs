@@ -745,7 +745,7 @@ impl SceneFile {
         let mut objects = Vec::new();
         for (i, keys) in self.sphere.into_iter().enumerate() {
             // Its place, written out only in a message (100,000 spheres would
-            // otherwise make as many strings, and five more each for its keys).
+            // otherwise make as many strings, and seven more each for its keys).
             let at = Lazy(|| format!("[[sphere]] number {}", i + 1));
             let shape = sphere(keys.center, keys.radius, &at)?;
             placed(&shape, &at, camera, light.position, MIN_RADIUS_RATIO_F64)?;
