@@ -228,8 +228,17 @@ fn read_apart(text: &str, part: usize) -> Option<SceneFile> {
     }
     let first = *cuts.first()?;
     cuts.push(text.len());
+    // The head must not have a key `sphere` of its own, not even `sphere = []`,
+    // whose array a `[[sphere]]` cannot extend; read once, as a table, to see.
+    let head = |text: &str| {
+        let table = toml::from_str::<toml::Table>(text).ok()?;
+        match table.contains_key("sphere") {
+            true => None,
+            false => table.try_into::<SceneFile>().ok(),
+        }
+    };
     let (head, parts) = rayon::join(
-        || toml::from_str::<SceneFile>(&text[..first]).ok(),
+        || head(&text[..first]),
         || {
             use rayon::prelude::*;
             cuts.par_windows(2)
@@ -237,15 +246,7 @@ fn read_apart(text: &str, part: usize) -> Option<SceneFile> {
                 .collect::<Option<Vec<_>>>()
         },
     );
-    // The head must not have a key `sphere` of its own, not even `sphere = []`,
-    // whose array a `[[sphere]]` cannot extend.
     let mut head = head?;
-    if toml::from_str::<toml::Table>(&text[..first])
-        .ok()?
-        .contains_key("sphere")
-    {
-        return None;
-    }
     head.sphere = parts?.into_iter().flat_map(|p| p.sphere).collect();
     Some(head)
 }
@@ -1223,7 +1224,7 @@ mod tests {
                         sphere = { center = [0, -100, 0], radius = 99 }\n";
 
     /// Sphere `i` of a test file, its keys varied from one to the next.
-    fn sphere(i: usize) -> String {
+    fn sphere_text(i: usize) -> String {
         let mut s = format!(
             "[[sphere]]\ncenter = [{}, {}, -{}]\nradius = 0.{}\n",
             (i % 13) as f64 * 0.25 - 1.5,
@@ -1246,7 +1247,7 @@ mod tests {
     fn file(count: usize) -> String {
         let mut text = HEAD.to_string();
         for i in 0..count {
-            let s = sphere(i);
+            let s = sphere_text(i);
             text += &match i % 6 {
                 1 => s.replace("[[sphere]]", "[[ sphere ]]"),
                 2 => s.replace("[[sphere]]\n", "[[sphere]]  \t\n"),
