@@ -371,6 +371,25 @@ impl Frame {
         }
     }
 
+    /// [`Frame::ray_buffers`] of columns `cols` of row `row`, appended to `out`
+    /// (the precision looked at once for the row, not once a pixel).
+    pub fn ray_buffers_row(
+        &self,
+        row: u32,
+        cols: std::ops::Range<u32>,
+        out: &mut Vec<([f32; 3], [f32; 3])>,
+    ) {
+        let records = (cols.clone()).map(|col| (col, self.at(row, col)));
+        match self.precision {
+            Precision::F32 => {
+                out.extend(records.map(|(c, r)| self.ray_buffers_in::<f32>(row, c, r)))
+            }
+            Precision::F64 => {
+                out.extend(records.map(|(c, r)| self.ray_buffers_in::<f64>(row, c, r)))
+            }
+        }
+    }
+
     #[inline]
     fn ray_buffers_in<T: crate::real::Real>(
         &self,

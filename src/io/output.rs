@@ -619,7 +619,7 @@ impl<'a> Palette<'a> {
                     ray_row.clear();
                     terms_row.clear();
                     if rays {
-                        ray_row.extend((0..frame.width).map(|col| frame.ray_buffers(row, col)));
+                        frame.ray_buffers_row(row, 0..frame.width, ray_row);
                     }
                     if terms {
                         terms_row.extend(pixels.iter().map(|p| frame.terms(p)));
@@ -779,22 +779,20 @@ fn miss_colour(row: u32, col: u32) -> [f32; 3] {
 pub(crate) fn to_byte(v: f32) -> u8 {
     // Clipped to [0, 1], a NaN to 0 (as `round` would make of it).
     let scaled = if v > 0.0 { v.min(1.0) } else { 0.0 } * 255.0;
-    // `scaled.round()`, halves away from zero, in float arithmetic only, which the
-    // compiler runs four values at a time in a loop of `to_byte`s (`round` is a
-    // call to the C library's `roundf` on x86-64, and a conversion to an integer
-    // one value at a time). Adding and taking away 2²³ rounds to the nearest
-    // whole number (halves to even), one less if that went up: the whole part.
-    // `scaled - whole` is exact.
+    // `scaled.round()`, halves away from zero, in float arithmetic only, which
+    // the compiler runs four values at a time in a loop of `to_byte`s (`round` is
+    // a call to the C library's `roundf` on x86-64, and a cast to an integer one
+    // value at a time). Rounding is the whole part of `scaled` plus one half, but
+    // 0.499 999 97 + 0.5 rounds up to 1 in float32; plus the float just below one
+    // half is right for every float from 0 to 255 `scaled` can be (the test below
+    // tries them all). Adding 2²³ rounds that sum to the nearest whole number, in
+    // the low bits of the result; one less where that went up: the whole part.
+    const BELOW_HALF: f32 = 0.499_999_97;
     const TWO_23: f32 = 8_388_608.0;
-    let nearest = (scaled + TWO_23) - TWO_23;
-    let whole = if nearest > scaled {
-        nearest - 1.0
-    } else {
-        nearest
-    };
-    let rounded = whole + if scaled - whole >= 0.5 { 1.0 } else { 0.0 };
-    // A whole number from 0 to 255 plus 2²³ has it in its low mantissa bits.
-    (rounded + TWO_23).to_bits() as u8
+    let sum = scaled + BELOW_HALF;
+    let nearest = sum + TWO_23;
+    let went_up = nearest - TWO_23 > sum;
+    (nearest.to_bits() - u32::from(went_up)) as u8
 }
 // ANCHOR_END: visualise
 
@@ -890,7 +888,7 @@ fn png_encoder<W: Write>(
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
     encoder.set_compression(png::Compression::Fast);
-    encoder.set_filter(png::Filter::Adaptive);
+    encoder.set_filter(png::Filter::Paeth);
     if png == PngEncoding::Srgb && PngEncoding::applies_to(buffer) {
         encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
     }
@@ -992,11 +990,20 @@ fn exr_sample(
         7..=9 => p.normal[k - 7],
         10..=12 => position[k - 10],
         13 => p.shadow,
-        14 if p.object == NO_OBJECT => -1.0,
-        14 => p.object as f32,
+        14 => object_sample(p),
         15..=23 => terms[(k - 15) / 3][(k - 15) % 3],
         24 => p.bounces as f32,
         _ => p.rays as f32,
+    }
+}
+
+/// The object channel's sample: the object's index, −1 on a miss.
+#[inline(always)]
+fn object_sample(p: &PixelRecord) -> f32 {
+    if p.object == NO_OBJECT {
+        -1.0
+    } else {
+        p.object as f32
     }
 }
 
@@ -1172,21 +1179,24 @@ fn block_bytes(
         let row = row as u32;
         rays.clear();
         terms.clear();
-        rays.extend((x0..x0 + width).map(|col| frame.ray_buffers(row, col as u32)));
+        frame.ray_buffers_row(row, x0 as u32..(x0 + width) as u32, &mut rays);
         terms.extend(pixels.iter().map(|p| frame.terms(p)));
         // Channel after channel, each a loop along the line of its own (the
         // channel's rule chosen once per line, not per sample).
         for (&k, bytes) in order.iter().zip(&mut channel_rows) {
             // The same numbers as `exr_sample` (tests/exr_readers.rs compares
-            // every sample); the rest through it.
+            // every sample).
             match k {
-                0..=2 => fill_samples(bytes, |x| pixels[x].colour[k]),
-                3..=5 => fill_samples(bytes, |x| rays[x].0[k - 3]),
-                6 => fill_samples(bytes, |x| pixels[x].depth),
-                7..=9 => fill_samples(bytes, |x| pixels[x].normal[k - 7]),
-                10..=12 => fill_samples(bytes, |x| rays[x].1[k - 10]),
-                15..=23 => fill_samples(bytes, |x| terms[x][(k - 15) / 3][(k - 15) % 3]),
-                _ => fill_samples(bytes, |x| exr_sample(k, &pixels[x], &rays[x], &terms[x])),
+                0..=2 => fill_samples(bytes, pixels.iter().map(|p| p.colour[k])),
+                3..=5 => fill_samples(bytes, rays.iter().map(|r| r.0[k - 3])),
+                6 => fill_samples(bytes, pixels.iter().map(|p| p.depth)),
+                7..=9 => fill_samples(bytes, pixels.iter().map(|p| p.normal[k - 7])),
+                10..=12 => fill_samples(bytes, rays.iter().map(|r| r.1[k - 10])),
+                13 => fill_samples(bytes, pixels.iter().map(|p| p.shadow)),
+                14 => fill_samples(bytes, pixels.iter().map(object_sample)),
+                15..=23 => fill_samples(bytes, terms.iter().map(|t| t[(k - 15) / 3][(k - 15) % 3])),
+                24 => fill_samples(bytes, pixels.iter().map(|p| p.bounces as f32)),
+                _ => fill_samples(bytes, pixels.iter().map(|p| p.rays as f32)),
             }
         }
         if let Some((palette, buffers)) = pictures {
@@ -1198,12 +1208,12 @@ fn block_bytes(
     (data, rows)
 }
 
-/// Fill one channel's samples of a line, `sample(x)` at column `x`, as native
+/// Fill one channel's samples of a line, one from `samples` a column, as native
 /// float32 bytes.
 #[inline(always)]
-fn fill_samples(bytes: &mut [u8], sample: impl Fn(usize) -> f32) {
-    for (x, b) in bytes.chunks_exact_mut(4).enumerate() {
-        b.copy_from_slice(&sample(x).to_ne_bytes());
+fn fill_samples(bytes: &mut [u8], samples: impl Iterator<Item = f32>) {
+    for (b, sample) in bytes.chunks_exact_mut(4).zip(samples) {
+        b.copy_from_slice(&sample.to_ne_bytes());
     }
 }
 // ANCHOR_END: exr
@@ -1302,20 +1312,18 @@ mod tests {
 
     #[test]
     fn to_byte_rounds_as_f32_round_does() {
-        // Every value a few ulps either side of each half level and each level,
-        // where the rounding decides between two levels.
-        for k in 0..=510u32 {
-            let centre = (k as f32 / 510.0).to_bits();
-            for bits in centre.saturating_sub(8)..=centre + 8 {
-                let v = f32::from_bits(bits);
-                assert_eq!(to_byte(v), rounded(v), "{v:e} ({bits:#x})");
-            }
-        }
-        // Every 997th float from 0 to 1, and what lies outside.
-        for bits in (0..=1f32.to_bits()).step_by(997) {
-            let v = f32::from_bits(bits);
-            assert_eq!(to_byte(v), rounded(v), "{v:e}");
-        }
+        // Every float from 0 to 1 (1,065,353,217 of them), in parallel, and what
+        // lies outside.
+        use rayon::prelude::*;
+        let wrong = (0..=1f32.to_bits())
+            .into_par_iter()
+            .map(f32::from_bits)
+            .find_first(|&v| to_byte(v) != rounded(v));
+        assert_eq!(wrong, None, "to_byte differs from rounding");
+        // Adding one half, as a first form did, is wrong once.
+        let half = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+        let v = 0.499_999_97 / 255.0;
+        assert_eq!((half(v), to_byte(v), rounded(v)), (1, 0, 0));
         for v in [-0.0, -1.0, 1.5, f32::INFINITY, f32::NEG_INFINITY, f32::NAN] {
             assert_eq!(to_byte(v), rounded(v), "{v:e}");
         }
