@@ -379,7 +379,7 @@ impl Frame {
         cols: std::ops::Range<u32>,
         out: &mut Vec<([f32; 3], [f32; 3])>,
     ) {
-        let records = (cols.clone()).map(|col| (col, self.at(row, col)));
+        let records = cols.map(|col| (col, self.at(row, col)));
         match self.precision {
             Precision::F32 => {
                 out.extend(records.map(|(c, r)| self.ray_buffers_in::<f32>(row, c, r)))

@@ -990,20 +990,11 @@ fn exr_sample(
         7..=9 => p.normal[k - 7],
         10..=12 => position[k - 10],
         13 => p.shadow,
-        14 => object_sample(p),
+        14 if p.object == NO_OBJECT => -1.0,
+        14 => p.object as f32,
         15..=23 => terms[(k - 15) / 3][(k - 15) % 3],
         24 => p.bounces as f32,
         _ => p.rays as f32,
-    }
-}
-
-/// The object channel's sample: the object's index, −1 on a miss.
-#[inline(always)]
-fn object_sample(p: &PixelRecord) -> f32 {
-    if p.object == NO_OBJECT {
-        -1.0
-    } else {
-        p.object as f32
     }
 }
 
@@ -1185,18 +1176,19 @@ fn block_bytes(
         // channel's rule chosen once per line, not per sample).
         for (&k, bytes) in order.iter().zip(&mut channel_rows) {
             // The same numbers as `exr_sample` (tests/exr_readers.rs compares
-            // every sample).
+            // every sample); the rest through it.
             match k {
                 0..=2 => fill_samples(bytes, pixels.iter().map(|p| p.colour[k])),
                 3..=5 => fill_samples(bytes, rays.iter().map(|r| r.0[k - 3])),
                 6 => fill_samples(bytes, pixels.iter().map(|p| p.depth)),
                 7..=9 => fill_samples(bytes, pixels.iter().map(|p| p.normal[k - 7])),
                 10..=12 => fill_samples(bytes, rays.iter().map(|r| r.1[k - 10])),
-                13 => fill_samples(bytes, pixels.iter().map(|p| p.shadow)),
-                14 => fill_samples(bytes, pixels.iter().map(object_sample)),
                 15..=23 => fill_samples(bytes, terms.iter().map(|t| t[(k - 15) / 3][(k - 15) % 3])),
-                24 => fill_samples(bytes, pixels.iter().map(|p| p.bounces as f32)),
-                _ => fill_samples(bytes, pixels.iter().map(|p| p.rays as f32)),
+                _ => fill_samples(
+                    bytes,
+                    (pixels.iter().zip(&rays).zip(&terms))
+                        .map(|((p, r), t)| exr_sample(k, p, r, t)),
+                ),
             }
         }
         if let Some((palette, buffers)) = pictures {
