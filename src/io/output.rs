@@ -1188,8 +1188,8 @@ fn block_bytes(
     let (x0, y0) = (index.pixel_position.x(), index.pixel_position.y());
     let (width, lines) = (index.pixel_size.width(), index.pixel_size.height());
     debug_assert!(x0 == 0 && width == frame.width as usize, "whole scan lines");
-    let mut data = vec![0u8; width * lines * order.len() * 4];
-    let mut channel_rows = data.chunks_exact_mut(width * 4);
+    // Each sample's four bytes pushed in turn (no zeros written first).
+    let mut data: Vec<[u8; 4]> = Vec::with_capacity(width * lines * order.len());
     let picture_count = pictures.map_or(0, |(_, buffers)| buffers.len());
     let (picture_row, part) = (width * 3, width * 3 * lines);
     let mut rows = vec![0u8; part * picture_count];
@@ -1204,18 +1204,21 @@ fn block_bytes(
         terms.extend(pixels.iter().map(|p| frame.terms(p)));
         // Channel after channel, each a loop along the line of its own (the
         // channel's rule chosen once per line, not per sample).
-        for (&k, bytes) in order.iter().zip(&mut channel_rows) {
+        for &k in order {
             // The same numbers as `exr_sample` (tests/exr_readers.rs compares
             // every sample); the rest through it.
             match k {
-                0..=2 => fill_samples(bytes, pixels.iter().map(|p| p.colour[k])),
-                3..=5 => fill_samples(bytes, rays.iter().map(|r| r.0[k - 3])),
-                6 => fill_samples(bytes, pixels.iter().map(|p| p.depth)),
-                7..=9 => fill_samples(bytes, pixels.iter().map(|p| p.normal[k - 7])),
-                10..=12 => fill_samples(bytes, rays.iter().map(|r| r.1[k - 10])),
-                15..=23 => fill_samples(bytes, terms.iter().map(|t| t[(k - 15) / 3][(k - 15) % 3])),
-                _ => fill_samples(
-                    bytes,
+                0..=2 => put_samples(&mut data, pixels.iter().map(|p| p.colour[k])),
+                3..=5 => put_samples(&mut data, rays.iter().map(|r| r.0[k - 3])),
+                6 => put_samples(&mut data, pixels.iter().map(|p| p.depth)),
+                7..=9 => put_samples(&mut data, pixels.iter().map(|p| p.normal[k - 7])),
+                10..=12 => put_samples(&mut data, rays.iter().map(|r| r.1[k - 10])),
+                15..=23 => put_samples(
+                    &mut data,
+                    terms.iter().map(|t| t[(k - 15) / 3][(k - 15) % 3]),
+                ),
+                _ => put_samples(
+                    &mut data,
                     (pixels.iter().zip(&rays).zip(&terms))
                         .map(|((p, r), t)| exr_sample(k, p, r, t)),
                 ),
@@ -1227,16 +1230,15 @@ fn block_bytes(
             palette.draw_rows(buffers, row, pixels, &rays, &terms, &mut colours, outs);
         }
     }
-    (data, rows)
+    (data.into_flattened(), rows)
 }
 
-/// Fill one channel's samples of a line, one from `samples` a column, as native
-/// float32 bytes.
+/// Append one channel's samples of a line to `data`, as native float32 bytes.
+/// (`samples` come from slices, so the vector knows their count up front and
+/// writes them in a loop without checks, four at a time.)
 #[inline(always)]
-fn fill_samples(bytes: &mut [u8], samples: impl Iterator<Item = f32>) {
-    for (b, sample) in bytes.chunks_exact_mut(4).zip(samples) {
-        b.copy_from_slice(&sample.to_ne_bytes());
-    }
+fn put_samples(data: &mut Vec<[u8; 4]>, samples: impl Iterator<Item = f32>) {
+    data.extend(samples.map(f32::to_ne_bytes));
 }
 // ANCHOR_END: exr
 
