@@ -771,12 +771,14 @@ fn heat(count: u32, most: u32) -> [f32; 3] {
     [c.r, c.g, c.b].map(|v| f32::from(v) / 255.0)
 }
 
+/// 2²³: from here up every float32 is a whole number (`fraction`, `to_byte`).
+const TWO_23: f32 = 8_388_608.0;
+
 /// `v − ⌊v⌋`, the place of `v` within its unit cell, 0 where `v` is not finite.
 /// The whole part is taken by a cast to an integer, which the compiler runs four
 /// values at a time (`floor` is a call to the C library's `floorf` on x86-64, one
 /// value at a time); from 2²³ up every float32 is whole.
 fn fraction(v: f32) -> f32 {
-    const TWO_23: f32 = 8_388_608.0;
     if v.abs() < TWO_23 {
         let truncated = v as i32 as f32;
         // (Plus 0 makes −0 into +0, as `v - v.floor()` does.)
@@ -818,7 +820,6 @@ pub(crate) fn to_byte(v: f32) -> u8 {
     // tries them all). Adding 2²³ rounds that sum to the nearest whole number, in
     // the low bits of the result; one less where that went up: the whole part.
     const BELOW_HALF: f32 = 0.499_999_97;
-    const TWO_23: f32 = 8_388_608.0;
     let sum = scaled + BELOW_HALF;
     let nearest = sum + TWO_23;
     let went_up = nearest - TWO_23 > sum;
