@@ -564,6 +564,58 @@ fn the_light_and_the_camera_moved_render_and_save_as_the_scene_file_does() {
     assert_eq!(server.get("/api/render?light=1,2").status, 400);
 }
 
+/// Two renders at once each have threads of their own: a small render of one
+/// view is answered while a large one of another view still runs. (In one
+/// shared pool the small one waited for all the large one's rows.)
+#[test]
+fn a_small_render_is_not_held_up_by_a_large_one() {
+    let server = Server::start(None);
+    let port = server.port;
+    let request = move |query: &str| {
+        exchange(
+            port,
+            &format!(
+                "GET /api/render?{query} HTTP/1.1\r\n\
+                 Host: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n"
+            ),
+        )
+    };
+    // Half a minute in a debug build, were it not cancelled.
+    let large = std::thread::spawn(move || request("view=a&width=1920&height=1080&spp=256"));
+    std::thread::sleep(Duration::from_millis(500));
+    let asked = Instant::now();
+    let small = request("view=b&width=30&height=20");
+    let took = asked.elapsed();
+    assert_eq!(small.status, 200);
+    // Milliseconds on threads of its own; behind the large one's rows, about
+    // as long as the large render itself.
+    assert!(
+        took < Duration::from_secs(5),
+        "the small render took {took:?}"
+    );
+    // Only now is the large one superseded: it was still rendering, so it is
+    // cancelled (it would be 200 had it finished first).
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let mut newer = Vec::new();
+    while !large.is_finished() {
+        assert!(Instant::now() < deadline && newer.len() < 1000);
+        newer.push(std::thread::spawn(move || {
+            request("view=a&width=30&height=20").status
+        }));
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let large = large.join().unwrap();
+    assert_eq!(
+        large.status,
+        409,
+        "{}",
+        String::from_utf8_lossy(&large.body)
+    );
+    for t in newer {
+        assert!([200, 409].contains(&t.join().unwrap()));
+    }
+}
+
 #[test]
 fn a_render_a_newer_request_of_its_view_supersedes_is_cancelled() {
     let server = Server::start(None);
