@@ -71,10 +71,7 @@ impl Server {
 
     /// `GET target` with the right Host header.
     fn get(&self, target: &str) -> Reply {
-        let host = format!("127.0.0.1:{}", self.port);
-        self.raw(&format!(
-            "GET {target} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n"
-        ))
+        get(self.port, target)
     }
 
     /// Send `request` as it is and read the whole answer.
@@ -120,6 +117,15 @@ impl Reply {
 
 /// Send `request` to 127.0.0.1:`port` and read the answer until the server
 /// closes the connection (every request here says `Connection: close`).
+/// `GET target` from the server on `port`, with the right Host header (from
+/// any thread: the port is all it needs).
+fn get(port: u16, target: &str) -> Reply {
+    exchange(
+        port,
+        &format!("GET {target} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n"),
+    )
+}
+
 fn exchange(port: u16, request: &str) -> Reply {
     let mut stream = TcpStream::connect(("127.0.0.1", port)).unwrap();
     stream
@@ -571,15 +577,7 @@ fn the_light_and_the_camera_moved_render_and_save_as_the_scene_file_does() {
 fn a_small_render_is_not_held_up_by_a_large_one() {
     let server = Server::start(None);
     let port = server.port;
-    let request = move |query: &str| {
-        exchange(
-            port,
-            &format!(
-                "GET /api/render?{query} HTTP/1.1\r\n\
-                 Host: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n"
-            ),
-        )
-    };
+    let request = move |query: &str| get(port, &format!("/api/render?{query}"));
     // Half a minute in a debug build, were it not cancelled.
     let large = std::thread::spawn(move || request("view=a&width=1920&height=1080&spp=256"));
     std::thread::sleep(Duration::from_millis(500));
@@ -623,13 +621,7 @@ fn a_render_a_newer_request_of_its_view_supersedes_is_cancelled() {
     // A render of minutes (1920 × 1080, 64 samples a pixel, in a debug build).
     let slow = std::thread::spawn(move || {
         let started = Instant::now();
-        let reply = exchange(
-            port,
-            &format!(
-                "GET /api/render?view=main&width=1920&height=1080&spp=64 HTTP/1.1\r\n\
-                 Host: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n"
-            ),
-        );
+        let reply = get(port, "/api/render?view=main&width=1920&height=1080&spp=64");
         (reply, started.elapsed())
     });
     // Newer renders of the same view, one every 50 ms until the slow one has
@@ -648,14 +640,7 @@ fn a_render_a_newer_request_of_its_view_supersedes_is_cancelled() {
             newer.len()
         );
         newer.push(std::thread::spawn(move || {
-            exchange(
-                port,
-                &format!(
-                    "GET /api/render?view=main&width=30&height=20 HTTP/1.1\r\n\
-                     Host: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n"
-                ),
-            )
-            .status
+            get(port, "/api/render?view=main&width=30&height=20").status
         }));
         std::thread::sleep(Duration::from_millis(50));
     }
