@@ -43,6 +43,9 @@ use api::{Refusal, Studio};
 /// Renders at once; more wait in line.
 pub const RENDERS_AT_ONCE: usize = 2;
 
+// The gate keeps one bit a render pool in a `u32`.
+const _: () = assert!(RENDERS_AT_ONCE <= 32);
+
 /// How long a render waits for its turn before the answer is 503.
 pub const QUEUE_WAIT: Duration = Duration::from_secs(30);
 
