@@ -265,6 +265,7 @@ fn geometry<T: Laned>(object: &Object<T>) -> (bool, T::Vec3, T::Vec3, T) {
 
 impl<T: Laned> Packed<T> {
     /// The numbers of `object` lit by `light`.
+    #[inline(always)]
     pub fn new(object: &Object<T>, light: &Light<T>) -> Packed<T> {
         Packed::gather([object; WIDTH], light)
     }
@@ -272,7 +273,10 @@ impl<T: Laned> Packed<T> {
     /// The numbers of `objects[i]` lit by `light` in lane `i`: what
     /// [`Packed::blend`] makes of the four objects' [`Packed::new`], without
     /// making four whole ones first (for the many objects of a BVH, which are
-    /// not kept in lanes).
+    /// not kept in lanes). Always inlined, as everything the packet loop calls:
+    /// as a call of its own it was compiled without AVX, and took about 7 % of
+    /// the fast engine's samples on 100,000 spheres (`perf record`).
+    #[inline(always)]
     fn gather(objects: [&Object<T>; WIDTH], light: &Light<T>) -> Packed<T> {
         let n = T::Lanes::from_array;
         let v = V3::<T>::from_vectors;
