@@ -115,8 +115,6 @@ impl Reply {
     }
 }
 
-/// Send `request` to 127.0.0.1:`port` and read the answer until the server
-/// closes the connection (every request here says `Connection: close`).
 /// `GET target` from the server on `port`, with the right Host header (from
 /// any thread: the port is all it needs).
 fn get(port: u16, target: &str) -> Reply {
@@ -126,6 +124,8 @@ fn get(port: u16, target: &str) -> Reply {
     )
 }
 
+/// Send `request` to 127.0.0.1:`port` and read the answer until the server
+/// closes the connection (every request here says `Connection: close`).
 fn exchange(port: u16, request: &str) -> Reply {
     let mut stream = TcpStream::connect(("127.0.0.1", port)).unwrap();
     stream
