@@ -137,6 +137,32 @@ fn exchange(port: u16, request: &str) -> Reply {
     parse_reply(&bytes)
 }
 
+/// Newer small renders of `view`, one every 50 ms until `running` has finished,
+/// each sent from a thread of its own so that one the server has not answered yet
+/// never holds the next back (one that came before the running render is
+/// superseded by it, and its own render may then wait behind the running one's);
+/// their statuses, in the order sent. Fails after two minutes or 1,000 requests.
+fn supersede_until_finished<R>(
+    port: u16,
+    view: &str,
+    running: &std::thread::JoinHandle<R>,
+) -> Vec<u16> {
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let target = format!("/api/render?view={view}&width=30&height=20");
+    let mut newer = Vec::new();
+    while !running.is_finished() {
+        assert!(
+            Instant::now() < deadline && newer.len() < 1000,
+            "the render of view {view} is still running after {} newer requests",
+            newer.len()
+        );
+        let target = target.clone();
+        newer.push(std::thread::spawn(move || get(port, &target).status));
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    newer.into_iter().map(|t| t.join().unwrap()).collect()
+}
+
 fn parse_reply(bytes: &[u8]) -> Reply {
     let end = bytes
         .windows(4)
@@ -593,15 +619,7 @@ fn a_small_render_is_not_held_up_by_a_large_one() {
     );
     // Only now is the large one superseded: it was still rendering, so it is
     // cancelled (it would be 200 had it finished first).
-    let deadline = Instant::now() + Duration::from_secs(120);
-    let mut newer = Vec::new();
-    while !large.is_finished() {
-        assert!(Instant::now() < deadline && newer.len() < 1000);
-        newer.push(std::thread::spawn(move || {
-            request("view=a&width=30&height=20").status
-        }));
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    let statuses = supersede_until_finished(port, "a", &large);
     let large = large.join().unwrap();
     assert_eq!(
         large.status,
@@ -609,8 +627,8 @@ fn a_small_render_is_not_held_up_by_a_large_one() {
         "{}",
         String::from_utf8_lossy(&large.body)
     );
-    for t in newer {
-        assert!([200, 409].contains(&t.join().unwrap()));
+    for status in statuses {
+        assert!([200, 409].contains(&status));
     }
 }
 
@@ -624,26 +642,12 @@ fn a_render_a_newer_request_of_its_view_supersedes_is_cancelled() {
         let reply = get(port, "/api/render?view=main&width=1920&height=1080&spp=64");
         (reply, started.elapsed())
     });
-    // Newer renders of the same view, one every 50 ms until the slow one has
-    // answered: one of them comes after it started and supersedes it. Each is
-    // sent from a thread of its own, so that one the server has not answered
-    // yet never holds the next back. (One that came before the slow one is
-    // superseded by it, and its render then waits in the thread pool behind the
-    // slow one's rows: a loop that waited for it sent nothing more, and the slow
-    // render ran to its end; CI saw that once.)
-    let deadline = Instant::now() + Duration::from_secs(120);
-    let mut newer = Vec::new();
-    while !slow.is_finished() {
-        assert!(
-            Instant::now() < deadline && newer.len() < 1000,
-            "the slow render is still running after {} newer requests",
-            newer.len()
-        );
-        newer.push(std::thread::spawn(move || {
-            get(port, "/api/render?view=main&width=30&height=20").status
-        }));
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    // Newer renders of the same view until the slow one has answered: one of
+    // them comes after it started and supersedes it. (Sent each from a thread of
+    // its own: a loop that waited for one superseded by the slow render, its own
+    // render behind the slow one's rows, sent nothing more, and the slow render
+    // ran to its end; CI saw that once.)
+    let statuses = supersede_until_finished(port, "main", &slow);
     let (reply, took) = slow.join().unwrap();
     assert_eq!(
         reply.status,
@@ -655,11 +659,13 @@ fn a_render_a_newer_request_of_its_view_supersedes_is_cancelled() {
         reply.error(),
         "cancelled: a newer request of view main superseded this one"
     );
-    eprintln!("superseded after {took:?}, {} newer requests", newer.len());
+    eprintln!(
+        "superseded after {took:?}, {} newer requests",
+        statuses.len()
+    );
     // Each newer one was answered with its frame or superseded in turn, and the
     // one claimed last had nothing after it: some frame came back. A request
     // after them all is superseded by nothing.
-    let statuses: Vec<u16> = newer.into_iter().map(|t| t.join().unwrap()).collect();
     assert!(
         statuses.iter().all(|s| [200, 409].contains(s)),
         "{statuses:?}"
