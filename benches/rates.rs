@@ -1,0 +1,112 @@
+//! How many float64 square roots and divisions this processor finishes a second,
+//! one at a time and four lanes at a time: `cargo bench --bench rates`.
+//!
+//! The packet tracer's speed-up over one ray at a time is bounded by these rates
+//! where its chains of square roots and divisions keep the divider busy
+//! (chapter 10). Each bench runs twenty-four independent chains (`x ← √(x + 1)` or
+//! `x ← 3 / (x + 1)`), enough to keep the unit full rather than wait on one
+//! result, and counts the lanes computed: divan's "item/s" is the rate. The
+//! four-lane runs are the AVX instructions `vsqrtpd` and `vdivpd` on 256-bit
+//! registers, written with `std::arch` (the same instructions the packet loop's
+//! AVX build is made of); where the processor has no AVX they are skipped.
+
+use divan::counter::ItemsCount;
+use divan::Bencher;
+use std::hint::black_box;
+
+fn main() {
+    divan::main();
+}
+
+/// Steps of each chain a bench iteration.
+const STEPS: usize = 10_000;
+/// Independent chains.
+const CHAINS: usize = 24;
+
+/// `f` applied `STEPS` times along each of `CHAINS` chains of one number each.
+/// `black_box` on every value keeps the compiler from putting two chains in one
+/// SIMD register: these are the scalar instructions `sqrtsd` and `divsd`.
+#[inline(always)]
+fn scalar(f: impl Fn(f64) -> f64) -> f64 {
+    let mut x = [1.5f64; CHAINS];
+    for _ in 0..STEPS {
+        for v in &mut x {
+            *v = f(black_box(*v));
+        }
+    }
+    x.iter().sum()
+}
+
+#[divan::bench]
+fn sqrt_one_lane(bencher: Bencher) {
+    bencher
+        .counter(ItemsCount::new(STEPS * CHAINS))
+        .bench(|| scalar(|x| (x + 1.0).sqrt()));
+}
+
+#[divan::bench]
+fn div_one_lane(bencher: Bencher) {
+    bencher
+        .counter(ItemsCount::new(STEPS * CHAINS))
+        .bench(|| scalar(|x| 3.0 / (x + 1.0)));
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use super::*;
+    use std::arch::x86_64::{
+        __m256d, _mm256_add_pd, _mm256_div_pd, _mm256_set1_pd, _mm256_sqrt_pd, _mm256_storeu_pd,
+    };
+
+    /// `f` applied `STEPS` times along each of `CHAINS` chains of four lanes.
+    #[inline(always)]
+    unsafe fn lanes(f: impl Fn(__m256d) -> __m256d) -> f64 {
+        let mut x = [_mm256_set1_pd(1.5); CHAINS];
+        for _ in 0..STEPS {
+            for v in &mut x {
+                *v = f(*v);
+            }
+        }
+        let mut sum = 0.0;
+        for v in x {
+            let mut lanes = [0.0; 4];
+            _mm256_storeu_pd(lanes.as_mut_ptr(), v);
+            sum += lanes.iter().sum::<f64>();
+        }
+        sum
+    }
+
+    #[target_feature(enable = "avx")]
+    unsafe fn sqrt4() -> f64 {
+        lanes(|x| _mm256_sqrt_pd(_mm256_add_pd(x, _mm256_set1_pd(1.0))))
+    }
+
+    #[target_feature(enable = "avx")]
+    unsafe fn div4() -> f64 {
+        lanes(|x| _mm256_div_pd(_mm256_set1_pd(3.0), _mm256_add_pd(x, _mm256_set1_pd(1.0))))
+    }
+
+    fn has_avx() -> bool {
+        std::is_x86_feature_detected!("avx")
+    }
+
+    #[divan::bench]
+    fn sqrt_four_lanes_avx(bencher: Bencher) {
+        if has_avx() {
+            bencher
+                .counter(ItemsCount::new(STEPS * CHAINS * 4))
+                // SAFETY: the processor has AVX (checked above).
+                .bench(|| unsafe { sqrt4() });
+        }
+    }
+
+    #[divan::bench]
+    fn div_four_lanes_avx(bencher: Bencher) {
+        if has_avx() {
+            bencher
+                .counter(ItemsCount::new(STEPS * CHAINS * 4))
+                // SAFETY: the processor has AVX (checked above).
+                .bench(|| unsafe { div4() });
+        }
+    }
+}
