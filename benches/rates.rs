@@ -37,18 +37,22 @@ fn scalar(f: impl Fn(f64) -> f64) -> f64 {
     x.iter().sum()
 }
 
+/// Time `run`, which computes `lanes` lanes at every step of every chain: the
+/// rate is in lanes a second.
+fn rate(bencher: Bencher, lanes: usize, run: impl Fn() -> f64 + Sync) {
+    bencher
+        .counter(ItemsCount::new(STEPS * CHAINS * lanes))
+        .bench(run);
+}
+
 #[divan::bench]
 fn sqrt_one_lane(bencher: Bencher) {
-    bencher
-        .counter(ItemsCount::new(STEPS * CHAINS))
-        .bench(|| scalar(|x| (x + 1.0).sqrt()));
+    rate(bencher, 1, || scalar(|x| (x + 1.0).sqrt()));
 }
 
 #[divan::bench]
 fn div_one_lane(bencher: Bencher) {
-    bencher
-        .counter(ItemsCount::new(STEPS * CHAINS))
-        .bench(|| scalar(|x| 3.0 / (x + 1.0)));
+    rate(bencher, 1, || scalar(|x| 3.0 / (x + 1.0)));
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -86,27 +90,22 @@ mod avx {
         lanes(|x| _mm256_div_pd(_mm256_set1_pd(3.0), _mm256_add_pd(x, _mm256_set1_pd(1.0))))
     }
 
-    fn has_avx() -> bool {
-        std::is_x86_feature_detected!("avx")
+    /// [`rate`] of `run`, four lanes a step, where the processor has AVX (the
+    /// fast engine's own check); skipped elsewhere.
+    fn four_lanes(bencher: Bencher, run: unsafe fn() -> f64) {
+        if raystep::fast::packet::has_avx() {
+            // SAFETY: the processor has AVX (checked above), all `run` needs.
+            rate(bencher, 4, || unsafe { run() });
+        }
     }
 
     #[divan::bench]
     fn sqrt_four_lanes_avx(bencher: Bencher) {
-        if has_avx() {
-            bencher
-                .counter(ItemsCount::new(STEPS * CHAINS * 4))
-                // SAFETY: the processor has AVX (checked above).
-                .bench(|| unsafe { sqrt4() });
-        }
+        four_lanes(bencher, sqrt4);
     }
 
     #[divan::bench]
     fn div_four_lanes_avx(bencher: Bencher) {
-        if has_avx() {
-            bencher
-                .counter(ItemsCount::new(STEPS * CHAINS * 4))
-                // SAFETY: the processor has AVX (checked above).
-                .bench(|| unsafe { div4() });
-        }
+        four_lanes(bencher, div4);
     }
 }
