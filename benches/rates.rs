@@ -9,9 +9,17 @@
 //! four-lane runs are the AVX instructions `vsqrtpd` and `vdivpd` on 256-bit
 //! registers, written with `std::arch` (the same instructions the packet loop's
 //! AVX build is made of); where the processor has no AVX they are skipped.
+//!
+//! The other thing every frame must do, whatever it computes, is store its
+//! records: `store_records_*` fills a 1920 × 1080 frame of [`PixelRecord`]s
+//! (52 bytes each, 108 MB) that was written before, as `bench` reuses its frame,
+//! on one thread and on rayon's pool (one thread a core), a row a task as the
+//! engines do. divan's "B/s" is the rate; the time is a frame's store floor.
 
-use divan::counter::ItemsCount;
+use divan::counter::{BytesCount, ItemsCount};
 use divan::Bencher;
+use rayon::prelude::*;
+use raystep::aov::{PixelRecord, RECORD_BYTES};
 use std::hint::black_box;
 
 fn main() {
@@ -53,6 +61,52 @@ fn sqrt_one_lane(bencher: Bencher) {
 #[divan::bench]
 fn div_one_lane(bencher: Bencher) {
     rate(bencher, 1, || scalar(|x| 3.0 / (x + 1.0)));
+}
+
+/// The frame `store_records_*` fills: 1920 × 1080.
+const WIDTH: usize = 1920;
+const HEIGHT: usize = 1080;
+
+/// Fill `line` (row `row`) with records that differ from pixel to pixel, so
+/// that no store can be left out or merged.
+fn fill_row(row: usize, line: &mut [PixelRecord]) {
+    for (x, record) in line.iter_mut().enumerate() {
+        let v = (row * WIDTH + x) as f32;
+        let mut r = PixelRecord::missed([v, v + 1.0, v + 2.0], 1, 2);
+        r.set_hit(v, [v, -v, 0.5], x % 2 == 0, x, 0.25, v * 0.5);
+        *record = r;
+    }
+}
+
+/// Time filling a frame, its pages already touched: `rows` runs `fill_row`
+/// on every row.
+fn store_frame(bencher: Bencher, rows: fn(&mut [PixelRecord])) {
+    let mut frame = vec![PixelRecord::missed([0.0; 3], 0, 0); WIDTH * HEIGHT];
+    rows(&mut frame);
+    bencher
+        .counter(BytesCount::new(WIDTH * HEIGHT * RECORD_BYTES))
+        .bench_local(|| {
+            rows(black_box(&mut frame));
+        });
+}
+
+#[divan::bench]
+fn store_records_one_thread(bencher: Bencher) {
+    store_frame(bencher, |frame| {
+        for (row, line) in frame.chunks_mut(WIDTH).enumerate() {
+            fill_row(row, line);
+        }
+    });
+}
+
+#[divan::bench]
+fn store_records_all_threads(bencher: Bencher) {
+    store_frame(bencher, |frame| {
+        frame
+            .par_chunks_mut(WIDTH)
+            .enumerate()
+            .for_each(|(row, line)| fill_row(row, line));
+    });
 }
 
 #[cfg(target_arch = "x86_64")]
