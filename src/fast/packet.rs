@@ -836,6 +836,7 @@ impl<T: Laned> Fast<T> {
         same.then_some(some)
     }
 
+    // ANCHOR: nearest_packet
     /// The nearest object along each ray of the lanes `alive`: its distance and
     /// index, lane by lane, and the lanes that found one.
     #[inline(always)]
@@ -857,7 +858,6 @@ impl<T: Laned> Fast<T> {
         (nearest.t, nearest.which, nearest.found.bits())
     }
 
-    // ANCHOR: nearest_packet
     /// The lanes among `alive` whose ray meets an object closer than `distance`:
     /// the shadow test, which stops once every lane is blocked.
     #[inline(always)]

@@ -52,10 +52,12 @@ impl<T: Real> Terms<T> {
 ///
 /// `ka·la + kd·ld·(L·N) + ks·ls·(N·H)^(shininess/4)`
 ///
-/// As in the tutorial, `L·N` is not clamped (a lit point of a sphere always faces
-/// the light). `N·H` is clamped at 0 before the power: a negative base with a
-/// fractional exponent would give NaN, and on the tutorial's scene the clamp moves
-/// no pixel by more than 3e-12.
+/// As in the tutorial, `L·N` is not clamped: with the `auto` step a lit point of a
+/// sphere always faces the light, and with the tutorial's fixed step a few points
+/// just past the terminator are lit with a slightly negative `L·N` (chapter 8).
+/// `N·H` is clamped at 0 before the power: a negative base with a fractional
+/// exponent would give NaN, and on the tutorial's scene the clamp moves no value by
+/// more than 2.2e-12 (chapter 8).
 #[inline]
 pub fn terms<T: Real>(
     material: &Material<T>,

@@ -27,7 +27,7 @@ use crate::real::Vector;
 use crate::scene::{Material, Object, Role, Scene, Shape};
 use crate::shade::blinn_phong::factors;
 use crate::shade::reflection::reflect;
-use crate::shade::shadow::{step_off, Offset, TUTORIAL_STEP};
+use crate::shade::shadow::{step_off, Offset, POINT_UNITS, RADIUS_UNITS, TUTORIAL_STEP};
 use crate::sphere::{Method, Sphere};
 use crate::Vec3;
 
@@ -1450,8 +1450,14 @@ fn bound(root: &Path) -> Result<String, Error> {
     let note = font(13.0, GREY, Anchor::Start);
     let scale = 110.0 / r;
     let labels = [
-        ("--offset scene", "8·u·(|C| + r): the size of the scene"),
-        ("--offset auto", "u·(10·r + 3·‖S‖): a bound of the error"),
+        (
+            "--offset scene",
+            "8·u·(|C| + r): the size of the scene".to_string(),
+        ),
+        (
+            "--offset auto",
+            format!("u·({RADIUS_UNITS}·r + {POINT_UNITS}·‖P‖): a bound of the error"),
+        ),
     ];
     for (panel, left) in [(0usize, 0.0), (1, 360.0)] {
         let centre = px(left + 150.0, 240.0);
@@ -1480,7 +1486,7 @@ fn bound(root: &Path) -> Result<String, Error> {
         let far = out + towards * (1.0 + 1.4 * r / towards.length());
         svg.arrow(at(out), at(far), pen(ORANGE, 1.8));
         svg.text(px(left + 20.0, 28.0), labels[panel].0, title);
-        svg.text(px(left + 20.0, 50.0), labels[panel].1, note);
+        svg.text(px(left + 20.0, 50.0), &labels[panel].1, note);
         svg.text(
             px(left + 20.0, 70.0),
             &format!("step {} = {:.2}·r", sci(h), h / r),
