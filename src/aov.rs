@@ -12,7 +12,7 @@
 //! | `normal` | `intersection` on | unit world-space normal at the first hit (outward for a sphere, towards the camera for a plane); `(0, 0, 0)` on a miss |
 //! | `position` | `intersection` on | `P`, the first hit's point in world space: the primary ray's origin + `depth`·direction, computed again from the camera as `direction` is, in the frame's precision, with the `depth` the record keeps (float32); `(0, 0, 0)` on a miss, as `normal` and as renderers' position passes (Cycles', Arnold's) give it: compositing filters spread a NaN over its neighbours, and `Z` = `+∞` or `object` = `−1` already tell a miss from a hit at the origin |
 //! | `shadow` | `intersection` on | `1` lit, `0` in shadow, `−1` on a miss. Before the `shadow` stage is on no shadow ray is cast, so every hit reads `1` |
-//! | `object` | `intersection` on | index of the object hit first, among the objects in play (spheres in file order, then the `[[plane]]` entries); `−1` on a miss |
+//! | `object` | `intersection` on | index of the object hit first, among the objects in play (the file's spheres in file order, then those of its `[generate]` section, then the `[[plane]]` entries); `−1` on a miss |
 //! | `ambient`, `diffuse`, `specular` | `blinn-phong` on | the three Blinn-Phong terms of the first hit (`ka·la`, `kd·ld·(L·N)`, `ks·ls·(N·H)^(shininess/4)`), as added to the pixel; `0` in shadow and on a miss, where none is computed |
 //! | `bounces` | `reflection` on | reflected rays the pixel's path traced: 0 to `max_depth − 1` |
 //! | `rays` | `intersection` on | every ray the pixel traced (primary, shadow and reflected, of every sample): where the time goes |

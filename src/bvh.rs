@@ -17,8 +17,8 @@
 //! leaf's spheres are a slice of it and no node allocates.
 //!
 //! **Traversal.** A ray enters the root's box; at a node it visits the nearer child
-//! first and skips any box it enters beyond the nearest hit found so far. Objects
-//! that no box can hold (true planes, the tutorial's huge floor sphere) stay
+//! first and skips any box it enters beyond the nearest hit found so far. The
+//! `[[plane]]` entries (true planes, the tutorial's huge floor sphere) stay
 //! outside the tree and are tested for every ray.
 //!
 //! The result is the plain loop's: the same object at the same distance, ties
@@ -87,7 +87,7 @@ pub struct Bvh {
 /// How far outside a sphere its intersection test may report a hit, in units of
 /// `u·(|O| + S)` (see [`Bvh::margin`]).
 ///
-/// The bound, as [`crate::shade::shadow::step_out`]'s is derived (Higham's
+/// The bound, as [`crate::shade::shadow::sphere_step`]'s is derived (Higham's
 /// model, `|δ| ≤ u` per operation, first order in `u`), for the stable test's
 /// `Δ/4 = r² − ‖h·d − m‖²` (the naive method builds no tree):
 ///
@@ -115,10 +115,10 @@ pub struct Bvh {
 /// scene both ways).
 pub const MARGIN: f64 = 64.0;
 
-/// A ray as the slab test sees it: its origin moved by the ray's margin towards
-/// the low faces (`to_min`) and towards the high ones (`to_max`), so that the
-/// test is of the box widened by the margin on every side, and the reciprocal of
-/// its direction.
+/// A ray as the slab test sees it: its origin shifted by the ray's margin `m`, by
+/// `+m` for the low faces (`to_min`: `min − (O + m)` is `(min − m) − O`) and by
+/// `−m` for the high ones (`to_max`), so that the test is of the box widened by
+/// the margin on every side; and the reciprocal of its direction.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Slabs {
     to_min: Vec3,
@@ -765,8 +765,8 @@ mod tests {
 
     #[test]
     fn uneven_scenes_keep_the_depth_within_the_stack() {
-        // Spheres each twice as far out as the one before: the heuristic cuts off
-        // one at a time, until the median takes over at SAH_DEPTH.
+        // Spheres each 1.5 times as far out as the one before: the heuristic cuts
+        // off one at a time, until the median takes over at SAH_DEPTH.
         let chain: Vec<Object> = (0..200)
             .map(|i| ball(1.5f64.powi(i), 0.0, 0.0, 0.1))
             .collect();

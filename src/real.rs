@@ -2,8 +2,10 @@
 //!
 //! `Real` is the few operations the tracer needs from a number, and
 //! [`Vector`] the few it needs from a 3-vector; `f32` (with glam's `Vec3`) and
-//! `f64` (with glam's `DVec3`) provide them. Every type of the tracer takes the
-//! precision as a parameter that defaults to `f64`, so `Ray` means `Ray<f64>`.
+//! `f64` (with glam's `DVec3`) provide them. The types the tracer computes in (`Ray`,
+//! the objects, the light, the hit, `Tracer`) take the precision as a parameter
+//! that defaults to `f64`, so `Ray` means `Ray<f64>`; what is set up once (the
+//! camera, the scene, the settings, the BVH) does not take it.
 //!
 //! The formulas without a branch (the normal, the step off a surface, the half
 //! vector, the mirrored direction, the camera's grid) ask less: only the
@@ -68,7 +70,7 @@ pub trait Real: Num + Debug + PartialOrd + Send + Sync + 'static {
     fn powf(self, e: Self) -> Self;
     /// The smaller of two.
     fn min(self, other: Self) -> Self;
-    /// 1 with the sign of `self` (+1 for +0).
+    /// 1 with the sign of `self` (+1 for +0 and for −0).
     fn signum(self) -> Self;
     /// Neither infinite nor NaN.
     fn is_finite(self) -> bool;

@@ -328,8 +328,8 @@ impl<T: Real> Tracer<T> {
             // ANCHOR_END: shadow_test
 
             // ANCHOR: shading
-            // Blinn-Phong, seen from the camera (on every bounce, as in the tutorial),
-            // at a lit point.
+            // Blinn-Phong at a lit point, seen from the viewer: by default the camera,
+            // on every bounce, as in the tutorial.
             let terms = (lit && self.stages.blinn_phong).then(|| {
                 let viewer = match self.viewer {
                     Viewer::Camera => T::Vec3::of(self.camera.position),

@@ -5,8 +5,8 @@
 //! still gives the buffers, so they read the same whatever the sample count.
 
 // ANCHOR: stratified
-/// Sample `sample` of `spp` (a square, n × n) in pixel (`row`, `col`): the centre
-/// of one cell of an n × n grid over the pixel, moved by a jitter within the cell.
+/// Sample `sample` of `spp` (a square, n × n) in pixel (`row`, `col`): the top-left
+/// corner of one cell of an n × n grid over the pixel, moved by a jitter within the cell.
 /// The jitter comes from a hash of the pixel and the sample, so every render gives
 /// the same samples. Returns the position in fractional rows and columns.
 pub fn stratified(row: u32, col: u32, sample: u32, spp: u32) -> (f64, f64) {
@@ -29,8 +29,8 @@ pub fn unit_interval(bits: u64) -> f64 {
 }
 
 /// SplitMix64 (Steele, Lea and Flood, 2014): a 64-bit hash whose outputs pass
-/// the usual statistical tests; one step of it turns a pixel's coordinates into
-/// its jitter.
+/// the usual statistical tests; one step of it turns a pixel's coordinates and
+/// sample number into the row jitter, a second step into the column jitter.
 pub fn splitmix64(x: u64) -> u64 {
     let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);

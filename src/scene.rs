@@ -190,9 +190,10 @@ pub fn blocked<T: Real>(objects: &[Object<T>], ray: &Ray<T>, distance: T, method
 // ANCHOR_END: nearest_hit
 
 /// One step of a search for the nearest hit that visits the objects in another
-/// order than [`nearest_hit`] (the BVH) or skips some (the tile masks): test object
-/// `index` and keep it in `nearest` if it is nearer, or as near with a lower index,
-/// so that the result is the plain loop's whatever the order.
+/// order than [`nearest_hit`] (the BVH's one-ray walk; the packets keep their hits
+/// by the same rule): test object `index` and keep it in `nearest` if it is
+/// nearer, or as near with a lower index, so that the result is the plain loop's
+/// whatever the order.
 #[inline]
 pub fn consider<T: Real>(
     objects: &[Object<T>],

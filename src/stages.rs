@@ -113,11 +113,14 @@ pub struct Stages {
     pub rays: bool,
     /// Rays are intersected with the spheres.
     pub intersection: bool,
-    /// Shadow rays decide whether a hit point sees the light.
+    /// Shadow rays decide whether a hit point sees the light (with the `auto`
+    /// step, a point on a sphere's side away from the light is in shadow without
+    /// one).
     pub shadow: bool,
     /// Hit points are lit by Blinn-Phong instead of showing their flat colour.
     pub blinn_phong: bool,
-    /// Rays bounce off surfaces up to `max_depth` times.
+    /// Rays bounce off surfaces: up to `max_depth` segments per path, so at most
+    /// `max_depth − 1` bounces.
     pub reflection: bool,
     /// `[[plane]]` entries take part.
     pub plane: bool,

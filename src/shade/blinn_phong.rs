@@ -47,14 +47,15 @@ impl<T: Real> Terms<T> {
 /// The terms of Blinn-Phong at a point.
 ///
 /// `normal` is the surface normal N, `to_light` the unit vector L towards the light
-/// and `to_viewer` the unit vector V towards the camera. With the half vector
-/// `H = normalize(L + V)`:
+/// and `to_viewer` the unit vector V towards the viewer (the camera, unless
+/// `--viewer ray-origin`). With the half vector `H = normalize(L + V)`:
 ///
 /// `ka·la + kd·ld·(L·N) + ks·ls·(N·H)^(shininess/4)`
 ///
-/// As in the tutorial, `L·N` is not clamped: with the `auto` step a lit point of a
-/// sphere always faces the light, and with the tutorial's fixed step a few points
-/// just past the terminator are lit with a slightly negative `L·N` (chapter 8).
+/// As in the tutorial, `L·N` is not clamped: with the `auto` step and the `shadow`
+/// stage on, a lit point of a sphere always faces the light, and with the
+/// tutorial's fixed step a few points just past the terminator are lit with a
+/// slightly negative `L·N` (chapter 8).
 /// `N·H` is clamped at 0 before the power: a negative base with a fractional
 /// exponent would give NaN, and on the tutorial's scene the clamp moves no value by
 /// more than 2.2e-12 (chapter 8).
