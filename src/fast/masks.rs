@@ -19,7 +19,8 @@ pub const TILE: (u32, u32) = (16, 8);
 
 /// For each tile of the image, the objects its primary rays can hit: bit `i` set
 /// means object `i` must be tested. Only for scenes of at most 64 objects (larger
-/// ones use the BVH); [`TileMasks::mask`] gives every bit when there are none.
+/// ones use the BVH, or the book's engine); [`TileMasks::mask`] gives every bit
+/// when there are none.
 #[derive(Clone, Debug, Default)]
 pub struct TileMasks {
     columns: u32,

@@ -40,12 +40,14 @@
 //! traces any of them, and `trace_packet` starts the light's distance and the
 //! direction to the viewer as soon as the hit point is known.
 //!
-//! The fast engine (`--engine fast`) traces scenes of up to [`MAX_OBJECTS`]
-//! objects by the plain loop (with the tile masks), and larger ones through the
-//! BVH, which a packet walks together (`Bvh::search_packet`, in
-//! `src/fast/walk.rs`). A larger scene without a BVH (`--accel off`, or
-//! `--intersect naive`), or a render with a stage `knows` does not list, is left
-//! to the book's row loop, one ray at a time.
+//! The fast engine (`--engine fast`) traces a scene with a BVH (from
+//! [`BVH_FROM`](crate::accel::BVH_FROM) spheres on with `--accel auto`, always
+//! with `--accel bvh`) through it, which a packet walks together
+//! (`Bvh::search_packet`, in `src/fast/walk.rs`), and one without, of up to
+//! [`MAX_OBJECTS`] objects, by the plain loop (with the tile masks). A larger
+//! scene without a BVH (`--accel off`, or `--intersect naive`), or a render with
+//! a stage `knows` does not list, is left to the book's row loop, one ray at a
+//! time.
 
 use std::borrow::Cow;
 
@@ -110,8 +112,8 @@ impl<T: Laned> Fast<T> {
             settings.spp,
             crate::samples::MAX_SPP
         );
-        // Packets search a short list by bit masks, a long one through the BVH;
-        // a stage the packet loop does not compute is left to the book's engine.
+        // Packets search through the BVH if there is one, else a short list by bit
+        // masks; a stage the packet loop does not compute is left to the book's engine.
         let known = Stage::ALL
             .iter()
             .all(|&s| !settings.stages.is_on(s) || knows(s));
@@ -175,9 +177,9 @@ pub fn has_avx() -> bool {
 }
 
 /// An object as the packet tracer reads it: every number it needs, in precision
-/// `T` and in every lane, worked out once per render as the scalar tracer works
-/// it out at each hit. Lane `i` of a blend (`Packed::blend`) holds the numbers
-/// of the object hit in lane `i`.
+/// `T` and in every lane, worked out once per render (at each hit, for the
+/// objects of a BVH) as the scalar tracer works it out at each hit. Lane `i` of
+/// a blend (`Packed::blend`) holds the numbers of the object hit in lane `i`.
 #[derive(Clone, Copy, Debug)]
 pub struct Packed<T: Laned> {
     /// The geometry.
@@ -685,7 +687,7 @@ impl<T: Laned> Fast<T> {
     }
 
     // ANCHOR: trace_packet
-    /// The book's [`Tracer::trace`](crate::render::Tracer::trace) for the four rays of `primary`, of which the lanes `lanes`
+    /// The book's [`Tracer::trace`](crate::render::Tracer::trace) for the four rays of `ray`, of which the lanes `lanes`
     /// count.
     #[inline(always)]
     fn trace_packet(&self, mut ray: Packet<T>, lanes: u32, candidates: u64) -> Traced4<T> {

@@ -22,8 +22,9 @@ pub trait PacketSearch {
 impl Bvh {
     /// [`Bvh::enter`] for four rays at once, in precision `L`: where each enters
     /// the box of `node`, widened by its margin, and the lanes that enter it
-    /// before their limit. `to_min` and `to_max` are the origins moved by each
-    /// lane's margin towards the low and the high faces ([`Bvh::margin`]).
+    /// before their limit. `to_min` and `to_max` are the origins shifted by each
+    /// lane's margin `m`, by `+m` for the low faces and by `−m` for the high ones,
+    /// which widens the box by `m` on every side ([`Bvh::margin`]).
     ///
     /// In float32 the origin, the direction, its reciprocal and each step of the
     /// slab test round, and a box might seem missed by a ray that grazes it. The

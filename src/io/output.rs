@@ -238,12 +238,12 @@ impl Pending {
     /// Put every file into place and remove the stale ones, all or nothing;
     /// refused with [`Error::Interrupted`] (and everything removed) after Ctrl-C.
     ///
-    /// Anything but a file (or a link) at a final name, a folder say, is refused
-    /// before a single rename. Then each old file (a stale one, or one a new file
-    /// replaces) is first moved aside under a temporary name, and each new file
-    /// renamed into place; should one of those steps fail, everything done is
-    /// undone in reverse, so the folder holds exactly the old files. Only when all
-    /// succeeded are the old files, now aside, removed.
+    /// A folder at a final name is refused before a single rename. Then each old
+    /// file (a stale one, or one a new file replaces) is first moved aside under a
+    /// temporary name, and each new file renamed into place; should one of those
+    /// steps fail, everything done is undone in reverse, so the folder holds
+    /// exactly the old files. Only when all succeeded are the old files, now aside,
+    /// removed.
     pub fn commit(mut self) -> Result<(), Error> {
         // Held while the files are renamed: a watchdog after Ctrl-C waits for it.
         let mut noted = crate::interrupt::files();

@@ -29,7 +29,8 @@ pub const MAX_SIDE: u32 = 16384;
 
 /// Largest accepted image, in pixels: 7680 × 4320 (8K). A render peaks at about
 /// [`PEAK_BYTES_PER_PIXEL`], so this one needs about 2.1 GB of memory (and writes
-/// 1.7 GB of files per stage).
+/// about 3.5 GB of files for a stage with every buffer, most of it the
+/// uncompressed `buffers.exr`: 104 bytes per pixel).
 pub const MAX_PIXELS: u64 = 7680 * 4320;
 
 /// Peak memory of a render and its files per pixel, rounded up from measurements:

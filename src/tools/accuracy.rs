@@ -559,10 +559,11 @@ pub fn surface_distance(object: &Object, p: Vec3) -> f64 {
 }
 
 /// The reference's shadow verdict at (near) `p` on object `index`, whose face
-/// `facing` was seen, with `L·N` there, or `None` where it is too close to call:
-/// on the terminator ([`terminator_band`]), or with the shadow ray grazing
-/// another sphere (its silhouette band, widened by the `auto` step at `p`: the
-/// shadow ray starts that far from the point judged).
+/// `facing` was seen, with `L·N` there and the terminator band at `p`
+/// ([`terminator_band`], for the caller to judge by), or `None` where it is too
+/// close to call: within [`TERMINATOR_BAND`] of the terminator, or with the
+/// shadow ray grazing another sphere (its silhouette band, widened by the `auto`
+/// step at `p`: the shadow ray starts that far from the point judged).
 fn reference_lit(
     objects: &[Object],
     index: usize,

@@ -229,7 +229,7 @@ pub struct SceneArgs {
 #[derive(Args, Debug, Default)]
 pub struct RuleArgs {
     /// The tutorial's program exactly: --precision f64 --intersect naive
-    /// --offset fixed:1e-5 (flags given beside it still apply).
+    /// --offset fixed:1e-5 --early-stop off (flags given beside it still apply).
     #[arg(long)]
     pub tutorial: bool,
     /// Compute in float32 or float64 [default: f64].
@@ -263,7 +263,8 @@ pub struct RuleArgs {
     pub early_stop: Option<Switch>,
     /// How the nearest hit is searched for; never changes a pixel: off (the plain
     /// loop over every object), auto (a BVH from 24 spheres on; with --engine fast
-    /// also tile masks for primary rays), bvh (always a BVH) [default: auto].
+    /// also tile masks for primary rays), bvh (a BVH whatever the number of
+    /// spheres); never a BVH with --intersect naive [default: auto].
     #[arg(long, value_enum)]
     pub accel: Option<Accel>,
     /// Which tracer renders; never changes a pixel: book (the code the chapters

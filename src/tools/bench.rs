@@ -1,11 +1,12 @@
 //! `raystep bench`: how fast a frame renders, against a yardstick, in one run.
 //!
-//! Four things are timed, their runs interleaved so that a noisy machine slows
-//! all of them alike: the engine asked for (`--engine`, default `fast`) with the
-//! threads asked for and with one thread, the other engine with the threads asked
-//! for, and the [yardstick](crate::tools::yardstick) (the tutorial's program ported
-//! plainly) with the same threads. Each is rendered once to warm up, then
-//! `runs` times; the median of the runs is reported. Only the render is timed:
+//! Four things are timed (five where the render builds a BVH: its build alone
+//! too), their runs interleaved so that a noisy machine slows all of them alike:
+//! the engine asked for (`--engine`, default `fast`) with the threads asked for
+//! and with one thread, the other engine with the threads asked for, and the
+//! [yardstick](crate::tools::yardstick) (the tutorial's program ported plainly)
+//! with the same threads. Each is rendered once to warm up, then `runs` times;
+//! the median of the runs is reported. Only the render is timed:
 //! the frame is allocated once, before the runs, and no file is written. Within
 //! each frame of the engine asked for, its rows are timed apart from the set-up
 //! before them (objects converted, BVH built), as a peer such as Embree times

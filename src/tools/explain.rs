@@ -30,7 +30,8 @@ pub struct Explanation {
     pub y: u32,
     /// The stages that were on, e.g. `rays+intersection+shadow`.
     pub stages: String,
-    /// Precision, intersection method, offset and early stop, in words.
+    /// Precision, intersection method, offset, viewer, early stop and samples per
+    /// pixel, in words.
     pub rules: String,
     /// The pixel's point on the screen rectangle.
     pub screen_point: [f64; 3],
@@ -39,7 +40,8 @@ pub struct Explanation {
     /// Distance along the primary ray to its first hit; `None` on a miss.
     pub depth: Option<f64>,
     /// `P`, the first hit's point as the `position` buffer holds it: the primary
-    /// ray walked the depth the record keeps (float32), in float32 (the hit's
+    /// ray walked the depth the record keeps (float32), in the render's
+    /// precision, rounded to float32 (the hit's
     /// `point` is the one the trace computed); `None` on a miss, where the buffer
     /// holds `(0, 0, 0)`.
     pub position: Option<[f64; 3]>,
