@@ -1,5 +1,6 @@
 //! Errors a user can cause, each a message that says what is wrong and what would
-//! be valid. The command line prints them and exits with [`USER_ERROR`].
+//! be valid. The command line prints them and exits with [`USER_ERROR`] (130 after
+//! an interrupt).
 
 use std::fmt;
 use std::path::PathBuf;

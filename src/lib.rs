@@ -24,11 +24,11 @@
 /// The 3-vector used for points, directions and colours (float64).
 pub use glam::DVec3 as Vec3;
 
-// Chapter 1: setting the scene.
+// Chapters 1 and 2: the scene, the camera and its rays.
 pub mod camera;
-pub mod scene;
-// Chapter 2: rays, and the numbers they are computed in.
 pub mod ray;
+pub mod scene;
+// Chapter 9: the numbers the tracer computes in, float32 or float64.
 pub mod real;
 // Chapter 3: intersection.
 pub mod sphere;

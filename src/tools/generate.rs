@@ -5,7 +5,7 @@
 //! A scene file lists its spheres up to [`MAX_LISTED`]; a larger one holds the
 //! recipe instead, a `[generate]` section (`spheres = N`, `seed = S`) that the
 //! scene loader turns into the same spheres with [`objects`]. A list of a million
-//! spheres would be a 120 MB file, which the TOML reader would take seconds and
+//! spheres would be a 165 MB file, which the TOML reader would take seconds and
 //! gigabytes to read.
 
 use std::fmt::Write;
@@ -15,8 +15,8 @@ pub use crate::io::scene_file::generated_objects as objects;
 use crate::scene::Scene;
 
 /// The most spheres a generated scene file lists one by one (a 16 MB file, near the
-/// 16 MiB a scene file may be; reading it takes the TOML reader 0.7–0.9 s and
-/// 530 MB); above, it holds the recipe.
+/// 16 MiB a scene file may be; the loader reads it in parts, as the TOML reader
+/// alone would take 0.8 s and 531 MB); above, it holds the recipe.
 pub const MAX_LISTED: usize = 100_000;
 
 /// The camera, light and floor of every generated scene, with the comment that

@@ -1,5 +1,6 @@
-//! The JSON every command prints (`--json`, the studio's API): one object with
-//! a `"schema"` version.
+//! The JSON the commands print (`--json`; `accuracy --json`, an array of them)
+//! and the studio's `/api/pixel` and `/api/diff` answer: one object with a
+//! `"schema"` version.
 
 /// The version of every JSON object raystep prints (`"schema": 1`): it grows when
 /// a field changes meaning or goes away, not when a field is added.

@@ -166,20 +166,20 @@ fn stamp(path: &Path) -> Option<Stamp> {
 struct Served {
     /// Grows by one on every reload, good or bad; 1 for the first load.
     version: u64,
-    /// The text of the last scene that loaded, and its name in messages.
+    /// The text of the last scene that loaded.
     text: Arc<str>,
     /// The last scene that loaded, at its own size.
     scene: Arc<Scene>,
     /// Why the latest reload failed, if it did (the scene is then the last good).
     error: Option<String>,
-    /// The file as last seen, and its bytes as last read (good or not).
+    /// The file as last read, and its bytes then (good or not).
     stamp: Option<Stamp>,
     /// A change seen at the last look, read once the file stays as it is for
     /// one more look (an editor that truncates and then writes is not read in
     /// between).
     settling: Option<Option<Stamp>>,
     bytes: Option<Vec<u8>>,
-    /// Scenes parsed at other sizes, for this version: (width, height, scene).
+    /// Scenes parsed at other sizes, for this version: (size, scene).
     sized: Vec<(SizeOverride, Arc<Scene>)>,
     /// The server is stopping: waiters leave.
     stopping: bool,
@@ -196,9 +196,9 @@ pub struct Studio {
 /// How many scenes at other sizes are kept parsed.
 const SIZED_KEPT: usize = 4;
 
-/// The file's bytes as `scene_file::load` would read them (at most its limit),
-/// or `None` if it would refuse them for their size, encoding, or a failure to
-/// read.
+/// The file's bytes as `scene_file::load` would read them (at most one byte past
+/// its limit), or `None` if they cannot be read; their size and encoding are
+/// checked by `Studio::text_of`.
 fn read_bytes(path: &Path) -> Option<Vec<u8>> {
     use std::io::Read;
     let mut bytes = Vec::new();
@@ -295,8 +295,8 @@ impl Studio {
         (served.version, served.error.clone())
     }
 
-    /// Look at the scene file: if it changed since the last look but not since
-    /// the one before, and its bytes differ, load it again (keeping the last
+    /// Look at the scene file: if it changed before the last look and not since
+    /// (and is not empty), and its bytes differ, load it again (keeping the last
     /// good scene if it no longer loads), count a new version and wake the
     /// waiters. Returns whether it reloaded.
     pub fn poll(&self) -> bool {

@@ -14,8 +14,8 @@
 //! - it listens on 127.0.0.1 only;
 //! - a request whose `Host` is not `127.0.0.1:PORT` or `localhost:PORT` is
 //!   refused with 421 (a page elsewhere cannot reach it through DNS rebinding),
-//!   and so, with 403, is one a browser marks as sent by another site
-//!   (`Sec-Fetch-Site`);
+//!   and so, with 403, is one a browser marks as sent by a page of another
+//!   origin (`Sec-Fetch-Site` other than `same-origin` or `none`);
 //! - the only paths are the page's own files, compiled into the binary, and the
 //!   API: nothing is ever read from the disk for a path, so `/../`, encoded dots
 //!   and absolute paths are 404, and no symbolic link is followed;
@@ -392,7 +392,7 @@ fn answer(shared: &Shared, request: Request) {
         return error(
             request,
             403,
-            "this server answers only its own page, not pages of other sites",
+            "this server answers only its own page, not pages of other origins",
         );
     }
     if !matches!(request.method(), Method::Get | Method::Head) {
