@@ -221,3 +221,21 @@ fn json_has_the_depth_or_null_and_the_cli_checks_the_pixel() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("shadow: stage off"), "{text}");
 }
+
+#[test]
+fn explain_with_the_fast_engine_says_it_tells_the_book_tracers_story() {
+    let book = raystep(&["explain", "--pixel", "150,60"]);
+    let fast = raystep(&["explain", "--pixel", "150,60", "--engine", "fast"]);
+    assert!(book.status.success() && fast.status.success());
+    // The same story on stdout (the fast engine gives the book's bits) ...
+    assert_eq!(book.stdout, fast.stdout);
+    // ... and a note on stderr that it is the book's tracer that is told,
+    // which -q silences as every status line.
+    let note = "explain follows the book's tracer";
+    assert!(!String::from_utf8_lossy(&book.stderr).contains(note));
+    assert!(String::from_utf8_lossy(&fast.stderr).contains(note));
+    let quiet = raystep(&["explain", "--pixel", "150,60", "--engine", "fast", "-q"]);
+    assert!(quiet.status.success());
+    assert_eq!(quiet.stdout, book.stdout);
+    assert!(!String::from_utf8_lossy(&quiet.stderr).contains(note));
+}

@@ -269,6 +269,12 @@ fn explain(args: &ExplainArgs) -> Result<(), Error> {
     let (scene, settings) = prepare(&args.frame)?;
     let (x, y) = args.pixel;
     check_pixel(&scene, x, y)?;
+    if settings.engine == Engine::Fast {
+        status!(
+            "explain follows the book's tracer one ray at a time; --engine fast gives the \
+             same bits, so this is its story too"
+        );
+    }
     let story = crate::tools::explain::explain(&scene, &settings, x, y);
     if args.json {
         say!("{}", json_text(&story, true));
