@@ -94,8 +94,8 @@ pub struct Fast<T: Laned = f64> {
     /// The objects as the packet tracer reads them; empty without packets or with
     /// a BVH.
     pub packed: Vec<Packed<T>>,
-    /// Run the packet tracer's AVX build ([`Settings::avx`], and the processor
-    /// has AVX).
+    /// Run the packet tracer's AVX build: packets are on, [`Settings::avx`] asks
+    /// for it, and the processor has AVX.
     pub avx: bool,
     /// The screen's `x` at each column, for the packet tracer's primary rays
     /// (empty without packets).

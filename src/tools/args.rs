@@ -162,7 +162,7 @@ pub enum Generated {
     /// N spheres resting on the floor, at 1920 × 1080; the radius shrinks as 1/√N.
     Spheres {
         /// How many spheres, 1 to 1,000,000. Up to 100,000 the scene file lists
-        /// them (a file of 100,000 is 16 MB, near the 16 MiB a scene file may be);
+        /// them (a file of 100,000 is 16.7 MB, near the 16 MiB a scene file may be);
         /// above, it holds their recipe, the scene file's generate section.
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
         count: u32,

@@ -14,7 +14,7 @@ pub use crate::io::generated::{spheres, Ball, MAX_GENERATED};
 pub use crate::io::scene_file::generated_objects as objects;
 use crate::scene::Scene;
 
-/// The most spheres a generated scene file lists one by one (a 16 MB file, near the
+/// The most spheres a generated scene file lists one by one (a 16.7 MB file, near the
 /// 16 MiB a scene file may be; the loader reads it in parts, as the TOML reader
 /// alone would take 0.8 s and 531 MB); above, it holds the recipe.
 pub const MAX_LISTED: usize = 100_000;
