@@ -656,7 +656,13 @@ fn output_that_cannot_be_written_is_an_error_and_a_closed_pipe_is_not() {
 
 #[test]
 fn threads_that_cannot_start_are_a_message_not_a_panic() {
-    // 1,000 threads' stacks (2 MB each) do not fit in 400 MB of address space.
+    // No thread's stack fits in 400 MB of address space: with RUST_MIN_STACK at
+    // 1 GB, the pool's first thread cannot start, and the pool says so. (With
+    // 2 MB stacks the address space would run out some hundred threads in, and
+    // then, now and then, inside a thread that had just started: std aborts the
+    // process when a new thread cannot map its signal stack, which no program
+    // can catch. That made this test fail now and then on a busy machine: one
+    // CI run of several on 2026-12-06.)
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("ok.toml"), OK_SCENE).unwrap();
     let out = Command::new("sh")
@@ -666,6 +672,7 @@ fn threads_that_cannot_start_are_a_message_not_a_panic() {
             env!("CARGO_BIN_EXE_raystep")
         ))
         .env("RAYON_NUM_THREADS", "1000")
+        .env("RUST_MIN_STACK", "1000000000")
         .current_dir(dir.path())
         .output()
         .unwrap();
