@@ -27,7 +27,9 @@ use crate::real::Vector;
 use crate::scene::{Material, Object, Role, Scene, Shape};
 use crate::shade::blinn_phong::factors;
 use crate::shade::reflection::reflect;
-use crate::shade::shadow::{step_off, Offset, POINT_UNITS, RADIUS_UNITS, TUTORIAL_STEP};
+use crate::shade::shadow::{
+    step_off, Offset, POINT_UNITS, RADIUS_UNITS, SCENE_FACTOR, TUTORIAL_STEP,
+};
 use crate::sphere::{Method, Sphere};
 use crate::Vec3;
 
@@ -1452,7 +1454,7 @@ fn bound(root: &Path) -> Result<String, Error> {
     let labels = [
         (
             "--offset scene",
-            "8·u·(|C| + r): the size of the scene".to_string(),
+            format!("{SCENE_FACTOR}·u·(|C| + r): the size of the scene"),
         ),
         (
             "--offset auto",
