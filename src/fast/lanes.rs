@@ -197,19 +197,17 @@ lanes!(f32, wide::f32x4, u32);
 pub struct F64x4(pub [f64; WIDTH]);
 
 impl F64x4 {
-    /// `f` of each lane. (Here and in `zip` the lanes are written out rather than
-    /// made by [`each`]: through `each` the render ran 8 % more instructions, the
-    /// compiler vectorising less of it.)
+    /// `f` of each lane.
     #[inline(always)]
     fn map(self, f: impl Fn(f64) -> f64) -> F64x4 {
-        F64x4([f(self.0[0]), f(self.0[1]), f(self.0[2]), f(self.0[3])])
+        F64x4(each(|i| f(self.0[i])))
     }
 
     /// `f` of each pair of lanes.
     #[inline(always)]
     fn zip(self, o: F64x4, f: impl Fn(f64, f64) -> f64) -> F64x4 {
         let (a, b) = (self.0, o.0);
-        F64x4([f(a[0], b[0]), f(a[1], b[1]), f(a[2], b[2]), f(a[3], b[3])])
+        F64x4(each(|i| f(a[i], b[i])))
     }
 
     /// `f` of each pair of lanes' bits.
