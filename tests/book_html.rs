@@ -240,6 +240,7 @@ fn the_built_book_typesets_its_maths_keeps_listings_at_the_margin_and_loads_noth
 
     let mut long = Vec::new();
     let mut with_maths = 0;
+    let mut listings = 0;
     for (source, page) in pages() {
         let html = std::fs::read_to_string(book.path().join(&page))
             .unwrap_or_else(|e| panic!("{page}: {e}"));
@@ -272,6 +273,7 @@ fn the_built_book_typesets_its_maths_keeps_listings_at_the_margin_and_loads_noth
 
         // Listings: the indentation all lines of a code block share is gone.
         for code in elements(main, "<pre><code", "</code></pre>") {
+            listings += 1;
             let text = unescape(&strip_tags(code));
             let lines: Vec<&str> = text.trim_end_matches('\n').lines().collect();
             let filled = lines.iter().filter(|l| !l.trim().is_empty());
@@ -289,10 +291,15 @@ fn the_built_book_typesets_its_maths_keeps_listings_at_the_margin_and_loads_noth
         }
     }
     assert!(with_maths >= 8, "{with_maths} pages with maths");
+    // The chapters hold about a hundred listings: the markup was found.
+    assert!(listings >= 50, "{listings} listings found");
 
     // The stylesheets and scripts the pages load do not load from elsewhere either.
+    let (mut stylesheets, mut scripts) = (0, 0);
     for entry in walk(book.path()) {
         let is = |ext: &str| entry.extension().is_some_and(|e| e == ext);
+        stylesheets += usize::from(is("css"));
+        scripts += usize::from(is("js"));
         if is("css") || is("js") {
             let text = std::fs::read_to_string(&entry).unwrap();
             for (at, _) in text.match_indices("url(") {
@@ -311,6 +318,10 @@ fn the_built_book_typesets_its_maths_keeps_listings_at_the_margin_and_loads_noth
             );
         }
     }
+    assert!(
+        stylesheets >= 1 && scripts >= 1,
+        "{stylesheets} stylesheets and {scripts} scripts in the built book"
+    );
     if !long.is_empty() {
         eprintln!(
             "listings over {LONG_LISTING} lines:\n  {}",

@@ -610,8 +610,12 @@ fn json_outputs_carry_schema_1_and_the_documented_fields() {
     ]);
     has(&bench, &["median_s", "rays"]);
     let accuracy = json(&["accuracy", "--case", "far-sphere", "--json"]);
-    for row in accuracy.as_array().unwrap() {
+    let rows = accuracy.as_array().unwrap();
+    // Two precisions × two intersection methods × four offsets.
+    assert_eq!(rows.len(), 16, "{accuracy}");
+    for row in rows {
         assert_eq!(row["schema"], 1, "{row}");
+        assert_eq!(row["case"], "far-sphere", "{row}");
     }
 }
 

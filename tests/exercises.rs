@@ -677,14 +677,17 @@ fn chapter_04_exercise_2_a_blocker_nearer_the_light_casts_a_larger_sharp_shadow(
             .filter(|&(r, c)| frame.at(r, c).shadow == 0.0 && l_dot_n(&frame, scene, r, c) > 0.0)
             .collect();
         let lit = render(scene, Stage::BlinnPhong);
-        let softest = borders(&lit, &bite, 0)
+        let steps: Vec<f32> = borders(&lit, &bite, 0)
             .into_iter()
             .filter(|&(_, b)| lit.at(b.0, b.1).shadow == 1.0)
             .map(|(a, b)| {
                 let (a, b) = (lit.at(a.0, a.1).colour, lit.at(b.0, b.1).colour);
                 (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f32::max)
             })
-            .fold(f32::INFINITY, f32::min);
+            .collect();
+        // The edge was found (the minimum of none would pass any bound).
+        assert!(steps.len() >= 10, "{} pixels along the edge", steps.len());
+        let softest = steps.into_iter().fold(f32::INFINITY, f32::min);
         (bite.len(), softest, pixels_of(&frame, 1).len())
     };
     let (now, edge, _) = bite(&scene(&text));

@@ -671,7 +671,8 @@ fn a_mutated_scene_file_is_refused_with_a_message_or_renders_sound_pixels() {
         any_settings(),
     );
     let tally = Tally::default();
-    let result = runner(cases(500)).run(&strategy, |(seed, mutations, size, random)| {
+    let n = cases(500);
+    let result = runner(n).run(&strategy, |(seed, mutations, size, random)| {
         let (_, original) = &SEEDS[seed.index(seeds)];
         let text = mutations
             .iter()
@@ -681,6 +682,17 @@ fn a_mutated_scene_file_is_refused_with_a_message_or_renders_sound_pixels() {
     eprintln!("{}", tally.summary("mutated scene files"));
     if let Err(e) = result {
         panic!("{e}");
+    }
+    // About one damaged file in five still loads (104 of 500 in one run): the
+    // renderer's half of the property is tested only if some do. A tenth is more
+    // than five standard deviations below that at 500 cases; with fewer than 200
+    // (`RAYSTEP_FUZZ_CASES`) chance alone could miss it, so it is not asked.
+    if n >= 200 {
+        let accepted = tally.accepted.get();
+        assert!(
+            accepted >= n / 10,
+            "only {accepted} of {n} mutated files were accepted and rendered"
+        );
     }
 }
 

@@ -290,20 +290,43 @@ fn every_bad_command_line_ends_in_its_message_and_writes_nothing() {
     assert!(cases.len() + scene_files().len() >= 200);
 }
 
-/// The output folder of a case where the user cannot write (only when not root:
-/// root may write anywhere).
+/// The output folder of a case where the user cannot write. Root may write
+/// anywhere, so as root (CI's user, often) raystep is run as the user `nobody`
+/// (uid 65534) through util-linux's `setpriv`.
 #[test]
 fn a_folder_without_write_permission_is_refused_before_rendering() {
     use std::os::unix::fs::PermissionsExt;
     let dir = tempfile::tempdir().unwrap();
+    // `nobody` may enter the temporary folder (made 0700) but not write there.
+    std::fs::set_permissions(dir.path(), std::fs::Permissions::from_mode(0o755)).unwrap();
     let locked = dir.path().join("locked");
     std::fs::create_dir(&locked).unwrap();
     std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o555)).unwrap();
-    if std::fs::write(locked.join("probe"), "").is_ok() {
-        eprintln!("skipped: this user (root) may write into a read-only folder");
-        return;
-    }
-    let out = raystep(dir.path(), &["render", "--out", "locked"]);
+    let args = ["render", "--out", "locked"];
+    let out = if std::fs::write(locked.join("probe"), "").is_ok() {
+        std::fs::remove_file(locked.join("probe")).unwrap();
+        let setpriv = Command::new("setpriv").arg("--version").output();
+        let found = match setpriv {
+            Ok(out) if out.status.success() => Ok(()),
+            _ => Err("setpriv (util-linux), to run raystep as nobody".to_string()),
+        };
+        if common::required(found, "the permission test as root").is_none() {
+            return;
+        }
+        // A copy of the binary beside the folder: `nobody` may not reach the
+        // checkout (under /root, say).
+        let binary = dir.path().join("raystep");
+        std::fs::copy(env!("CARGO_BIN_EXE_raystep"), &binary).unwrap();
+        (Command::new("setpriv"))
+            .args(["--reuid=65534", "--regid=65534", "--clear-groups"])
+            .arg(&binary)
+            .args(args)
+            .current_dir(dir.path())
+            .output()
+            .unwrap()
+    } else {
+        raystep(dir.path(), &args)
+    };
     check_output(
         "a read-only folder",
         &out,
@@ -501,8 +524,25 @@ fn a_killed_render_leaves_whole_files_and_the_next_run_clears_its_temporaries() 
     eprintln!("{left_temporaries} temporary files were left by the kills");
 }
 
+/// `n` with a comma between each three digits, as the help writes counts.
+fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (k, digit) in digits.chars().enumerate() {
+        if k > 0 && (digits.len() - k) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(digit);
+    }
+    out
+}
+
 #[test]
 fn help_states_every_limit_with_the_numbers_the_code_uses() {
+    assert_eq!(
+        [thousands(7), thousands(100_000), thousands(1_000_000)],
+        ["7", "100,000", "1,000,000"]
+    );
     use raystep::io::scene_file::*;
     let help = raystep(Path::new("."), &["--help"]);
     let help = String::from_utf8_lossy(&help.stdout);
@@ -527,6 +567,15 @@ fn help_states_every_limit_with_the_numbers_the_code_uses() {
         format!(
             "fits in {gigabytes}: about {}\n                 bytes per sphere",
             raystep::tools::cli::SCALE_BYTES_PER_SPHERE
+        ),
+        format!(
+            "at most {} spheres, listed up to {} and above",
+            thousands(raystep::tools::generate::MAX_GENERATED),
+            thousands(raystep::tools::generate::MAX_LISTED)
+        ),
+        format!(
+            "spheres = N, at most {})",
+            thousands(raystep::tools::generate::MAX_GENERATED)
         ),
     ] {
         assert!(
@@ -580,8 +629,11 @@ fn output_that_cannot_be_written_is_an_error_and_a_closed_pipe_is_not() {
     use std::io::Read;
     use std::process::Stdio;
     let full = Path::new("/dev/full");
-    if !full.exists() {
-        eprintln!("no /dev/full here: the full-device cases are skipped");
+    let found = match full.exists() {
+        true => Ok(()),
+        false => Err("/dev/full".to_string()),
+    };
+    if common::required(found, "the full-device cases").is_none() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

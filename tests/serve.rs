@@ -836,6 +836,27 @@ fn a_bad_option_is_400_with_the_command_lines_message_and_the_server_keeps_servi
     assert!(!out.exists(), "nothing is written");
 }
 
+/// The address the server prints is a text it formats itself, so the tests that
+/// connect to it would pass whatever it bound: here the other loopback addresses
+/// must be refused. (On Linux every address of 127.0.0.0/8 is this machine, so a
+/// server bound to 0.0.0.0, or to 127.0.0.2, would accept there.)
+#[test]
+fn the_studio_listens_on_127_0_0_1_only() {
+    let server = Server::start(None);
+    let port = server.port;
+    assert_eq!(server.get("/api/scene").status, 200, "127.0.0.1 is served");
+    for other in ["127.0.0.2", "127.1.2.3"] {
+        assert!(
+            TcpStream::connect_timeout(
+                &format!("{other}:{port}").parse().unwrap(),
+                Duration::from_secs(5)
+            )
+            .is_err(),
+            "{other}:{port} accepts a connection: the studio must listen on 127.0.0.1 only"
+        );
+    }
+}
+
 #[test]
 fn a_request_for_another_host_is_421() {
     let server = Server::start(None);
