@@ -117,6 +117,10 @@ pub struct Rays {
     pub shadow: u64,
     /// Rays from a hit point in the mirrored direction.
     pub reflection: u64,
+    /// Paths the book's [`Tracer::trace`](crate::render::Tracer::trace) followed,
+    /// counted at its first segment: not rays, and in no total. The fast
+    /// engine's packets follow none.
+    pub paths: u64,
 }
 
 impl Rays {
@@ -131,6 +135,7 @@ impl std::ops::AddAssign for Rays {
         self.primary += other.primary;
         self.shadow += other.shadow;
         self.reflection += other.reflection;
+        self.paths += other.paths;
     }
 }
 
@@ -302,9 +307,10 @@ pub struct Frame {
     /// which build of its packet loop ran.
     pub packets: Packets,
     /// The paths the book's [`Tracer::trace`](crate::render::Tracer::trace)
-    /// followed for this frame: every pixel's (and sample's) with the book engine,
-    /// none where the fast engine traced them in packets. A test holds the
-    /// default render to it, so that the book's code is the code that renders.
+    /// followed for this frame ([`Rays::paths`], counted inside it): every
+    /// pixel's (and sample's) with the book engine past the `rays` stage, none
+    /// where the fast engine traced them in packets. A test holds the default
+    /// render to it, so that the book's code is the code that renders.
     pub book_paths: u64,
     /// `width × height` records, row-major, top row first.
     pub pixels: Vec<PixelRecord>,

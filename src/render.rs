@@ -179,12 +179,13 @@ pub trait Observer<T: Real> {
 impl<T: Real> Observer<T> for () {}
 
 /// The render's observer: it counts the rays a path traces, for the `rays` and
-/// `bounces` buffers.
+/// `bounces` buffers, and the paths `trace` followed.
 impl<T: Real> Observer<T> for Rays {
     fn primary(&mut self, _ray: &Ray<T>) {
         self.primary += 1;
     }
     fn segment(&mut self, index: u32, _ray: &Ray<T>, _weight: T) {
+        self.paths += u64::from(index == 0);
         self.reflection += u64::from(index > 0);
     }
     fn shadow_ray(&mut self, _ray: &Ray<T>, _light_distance: T) {
@@ -487,7 +488,7 @@ fn render_in<T: Real>(
         book_row(tracer, settings.spp, row, line)
     });
     frame.describe(scene, tracer, settings, rays);
-    frame.book_paths = rays.primary;
+    frame.book_paths = rays.paths;
 }
 
 /// The rows of `frame` (`width` pixels each) traced in parallel by `row`, which

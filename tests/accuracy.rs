@@ -78,7 +78,6 @@ fn float32_with_the_bound_passes_every_case_within_its_bands() {
         assert_eq!((m.false_hits, m.false_misses), (0, 0), "{name}: {m:?}");
         assert_eq!(m.stuck, 0.0, "{name}");
         assert_eq!(m.wrong_shadows, 0, "{name}: {m:?}");
-        assert!(m.wrong_shadows_1e3 >= m.wrong_shadows, "{name}: {m:?}");
         if m.limit == "ok" {
             assert_eq!(m.wrong_shadows_1e3, 0, "{name}: {m:?}");
             plain += 1;
@@ -113,6 +112,8 @@ fn the_scene_sized_offset_fails_in_float32_where_the_bound_does_not() {
     // Measured: 3,840 (5,920 outside 1e-3), against 0 (0).
     let floor = run("horizon-low-light", F32, Stable, SCENE);
     assert!(floor.wrong_shadows > 1000, "{floor:?}");
+    // Those outside 1e-3 include those outside the band.
+    assert!(floor.wrong_shadows_1e3 >= floor.wrong_shadows, "{floor:?}");
     assert!(floor.worst_facing > 1.3e-3, "{floor:?}");
     let floor = run("horizon-low-light", F32, Stable, AUTO);
     assert_eq!(floor.wrong_shadows, 0, "{floor:?}");
@@ -401,8 +402,12 @@ proptest! {
         let side = if from.dot(normal) >= 0.0 { 1.0 } else { -1.0 };
         let origin = point + normal * side * s * (0.1 + from.length()) + (from - normal * from.dot(normal)) * s;
         let target = point + (aim - normal * aim.dot(normal)) * s;
+        // The origin is off the plane and the target on it: in float64 the ray
+        // always hits (as for the sphere above, float32 may round the target off).
+        let f64_result = common::plane_recast::<f64>(point, normal, origin, target, out, auto_step);
+        prop_assert!(f64_result.is_some(), "f64: a ray aimed at the plane misses it");
         for (precision, result) in [
-            ("f64", common::plane_recast::<f64>(point, normal, origin, target, out, auto_step)),
+            ("f64", f64_result),
             ("f32", common::plane_recast::<f32>(point, normal, origin, target, out, auto_step)),
         ] {
             if let Some((misses, meets)) = result {

@@ -50,6 +50,24 @@ fn check(story: &Explanation, record: &PixelRecord, settings: &Settings) {
     if !settings.stages.intersection {
         return;
     }
+    // The story's own numbers add up: each segment's light times its weight
+    // makes the sum (computed in the render's precision, hence the tolerance),
+    // and the sum clipped is the colour.
+    let mut sum = [0.0f64; 3];
+    for segment in &story.segments {
+        if let Some(light) = segment.hit.as_ref().and_then(|h| h.illumination) {
+            (0..3).for_each(|k| sum[k] += light[k] * segment.weight);
+        }
+    }
+    for k in 0..3 {
+        let unclipped = story.unclipped[k];
+        assert!(
+            (sum[k] - unclipped).abs() <= 1e-5 * (1.0 + unclipped.abs()),
+            "{at}: the segments add up to {sum:?}, the story says {:?}",
+            story.unclipped
+        );
+        assert_eq!(unclipped.clamp(0.0, 1.0), story.colour[k], "{at}");
+    }
     assert_eq!(story.rays[2], u64::from(record.bounces), "{at}");
     assert_eq!(
         story.depth.map(|d| d as f32),

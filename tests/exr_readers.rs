@@ -204,6 +204,7 @@ fn the_chapter_oiiotool_command_prints_every_channel_of_the_pixel() {
         .split(", ")
         .collect();
     assert_eq!(values.len(), EXR_CHANNELS.len(), "{printed}");
+    assert_eq!(names.len(), values.len(), "{info}");
     // The numbers `raystep explain --pixel 74,125` tells: depth 4.64808 and the
     // floor (object 3), in shadow, two rays.
     let scene = raystep::io::scene_file::seed();

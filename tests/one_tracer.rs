@@ -1,7 +1,8 @@
 //! The code the book shows is the code that renders: a default render follows
 //! every pixel's path through the book's `Tracer::pixel` and `Tracer::trace`
 //! (src/render.rs), and only `--engine fast` leaves them to the packet tracer.
-//! (`tests/speed.rs` holds the two engines to the same bits.)
+//! The paths are counted inside `trace` (`Rays::paths`, at a path's first
+//! segment). (`tests/speed.rs` holds the two engines to the same bits.)
 
 mod common;
 
@@ -23,7 +24,13 @@ fn a_default_render_follows_every_path_through_the_books_trace() {
             let frame = render(&scene, &settings, &|_| {});
             assert_eq!(frame.engine, Engine::Book);
             assert_eq!(frame.packets, Packets::Off);
-            assert_eq!(frame.book_paths, pixels, "{stage}: one book path per pixel");
+            assert_eq!(
+                frame.rays.primary, pixels,
+                "{stage}: a primary ray per pixel"
+            );
+            // At the `rays` stage `pixel` colours the direction and traces nothing.
+            let paths = if stage == Stage::Rays { 0 } else { pixels };
+            assert_eq!(frame.book_paths, paths, "{stage}: one book path per pixel");
         }
     }
     // Samples are traced by the book too: the centre ray and four samples.

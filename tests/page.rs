@@ -163,8 +163,9 @@ fn the_page_shows_the_exact_numbers_of_the_pixel_under_the_mouse() {
     }
 
     // Every number the page shows, against buffers.exr.
-    for ((stage, buffer, (x, y)), shown) in probes.iter().zip(report["probes"].as_array().unwrap())
-    {
+    let shown = report["probes"].as_array().unwrap();
+    assert_eq!(shown.len(), probes.len(), "a readout for every probe");
+    for ((stage, buffer, (x, y)), shown) in probes.iter().zip(shown) {
         let at = format!("{stage} {buffer} ({x}, {y})");
         assert_eq!(shown["readout"]["stage"], *stage, "{at}");
         assert_eq!(shown["readout"]["x"], x.to_string(), "{at}");

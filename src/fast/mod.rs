@@ -143,5 +143,5 @@ fn render_in<T: Laned>(
         (true, true) => Packets::Avx,
     };
     // The fallback follows the book's paths; packets do not.
-    frame.book_paths = if fast.packets { 0 } else { rays.primary };
+    frame.book_paths = rays.paths;
 }

@@ -449,6 +449,8 @@ impl<T: Laned> Traced4<T> {
             primary: 1,
             shadow: u64::from(self.shadow_rays[i]),
             reflection: u64::from(self.reflection_rays[i]),
+            // Not through the book's `trace`.
+            paths: 0,
         })
     }
 }
