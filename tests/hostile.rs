@@ -524,25 +524,23 @@ fn a_killed_render_leaves_whole_files_and_the_next_run_clears_its_temporaries() 
     eprintln!("{left_temporaries} temporary files were left by the kills");
 }
 
-/// `n` with a comma between each three digits, as the help writes counts.
-fn thousands(n: usize) -> String {
-    let digits = n.to_string();
-    let mut out = String::new();
-    for (k, digit) in digits.chars().enumerate() {
-        if k > 0 && (digits.len() - k) % 3 == 0 {
-            out.push(',');
-        }
-        out.push(digit);
-    }
-    out
+#[test]
+fn counts_are_grouped_by_three_digits_as_the_help_writes_them() {
+    let grouped = common::grouped;
+    assert_eq!(
+        [
+            grouped(7),
+            grouped(999),
+            grouped(1000),
+            grouped(100_000),
+            grouped(1_000_000)
+        ],
+        ["7", "999", "1,000", "100,000", "1,000,000"]
+    );
 }
 
 #[test]
 fn help_states_every_limit_with_the_numbers_the_code_uses() {
-    assert_eq!(
-        [thousands(7), thousands(100_000), thousands(1_000_000)],
-        ["7", "100,000", "1,000,000"]
-    );
     use raystep::io::scene_file::*;
     let help = raystep(Path::new("."), &["--help"]);
     let help = String::from_utf8_lossy(&help.stdout);
@@ -570,12 +568,12 @@ fn help_states_every_limit_with_the_numbers_the_code_uses() {
         ),
         format!(
             "at most {} spheres, listed up to {} and above",
-            thousands(raystep::tools::generate::MAX_GENERATED),
-            thousands(raystep::tools::generate::MAX_LISTED)
+            common::grouped(raystep::tools::generate::MAX_GENERATED),
+            common::grouped(raystep::tools::generate::MAX_LISTED)
         ),
         format!(
             "spheres = N, at most {})",
-            thousands(raystep::tools::generate::MAX_GENERATED)
+            common::grouped(raystep::tools::generate::MAX_GENERATED)
         ),
     ] {
         assert!(

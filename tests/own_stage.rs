@@ -319,37 +319,24 @@ fn the_numbers_chapter_12_quotes() {
     for quoted in [
         format!(
             "Of the {} pixels whose first hit is lit, {} have",
-            grouped(lit_hits),
-            grouped(touched)
+            common::grouped(lit_hits),
+            common::grouped(touched)
         ),
         format!("{} are buried: all eight", buried.len()),
         format!(
             "{} pixels ({percent:.2} %) change",
-            grouped(d.over_one_step)
+            common::grouped(d.over_one_step)
         ),
         format!("by {:.4}, at row 150, column 149", d.largest),
         format!(
             "{} probes, against {} rays",
-            grouped(probes as usize),
-            grouped(rays.total() as usize)
+            common::grouped(probes as usize),
+            common::grouped(rays.total() as usize)
         ),
     ] {
         assert!(text.contains(&quoted), "chapter 12 should say {quoted:?}");
     }
     show(&off, &on);
-}
-
-/// `n` with a comma between each group of three digits, as the book writes it.
-fn grouped(n: usize) -> String {
-    let digits = n.to_string();
-    let mut out = String::new();
-    for (i, digit) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
-            out.push(',');
-        }
-        out.push(digit);
-    }
-    out
 }
 
 /// With `RAYSTEP_OWN_STAGE_PNG` set, write the pictures without and with the

@@ -86,6 +86,20 @@ pub fn raystep(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
         .expect("the binary runs")
 }
 
+/// `n` with a comma between each group of three digits, as the book and the
+/// help write counts.
+pub fn grouped(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, digit) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(digit);
+    }
+    out
+}
+
 /// Chromium and Node.js with playwright-core, as the browser tests drive them
 /// (`tests/browser/`), or what is missing.
 pub fn browser_tools() -> Result<std::path::PathBuf, String> {
