@@ -118,8 +118,10 @@ pub struct Rays {
     /// Rays from a hit point in the mirrored direction.
     pub reflection: u64,
     /// Paths the book's [`Tracer::trace`](crate::render::Tracer::trace) followed,
-    /// counted at its first segment: not rays, and in no total. The fast
-    /// engine's packets follow none.
+    /// counted inside it at their first segment: not rays, and in no total.
+    /// Every pixel's (and sample's) with the book engine past the `rays` stage,
+    /// none where the fast engine traced them in packets. A test holds the
+    /// default render to it, so that the book's code is the code that renders.
     pub paths: u64,
 }
 
@@ -306,12 +308,6 @@ pub struct Frame {
     /// How the fast engine traced them: one ray at a time (the book's engine), or
     /// which build of its packet loop ran.
     pub packets: Packets,
-    /// The paths the book's [`Tracer::trace`](crate::render::Tracer::trace)
-    /// followed for this frame ([`Rays::paths`], counted inside it): every
-    /// pixel's (and sample's) with the book engine past the `rays` stage, none
-    /// where the fast engine traced them in packets. A test holds the default
-    /// render to it, so that the book's code is the code that renders.
-    pub book_paths: u64,
     /// `width × height` records, row-major, top row first.
     pub pixels: Vec<PixelRecord>,
 }
@@ -330,7 +326,6 @@ impl Frame {
             rays: Rays::default(),
             engine: Engine::Book,
             packets: Packets::Off,
-            book_paths: 0,
             // Filled on every thread: the first touch of each page of a fresh
             // frame (108 MB at 1920 × 1080) is the kernel's work, and sharing
             // it took a sixth off the fast engine's `render` seconds there.

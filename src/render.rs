@@ -488,7 +488,6 @@ fn render_in<T: Real>(
         book_row(tracer, settings.spp, row, line)
     });
     frame.describe(scene, tracer, settings, rays);
-    frame.book_paths = rays.paths;
 }
 
 /// The rows of `frame` (`width` pixels each) traced in parallel by `row`, which
@@ -603,6 +602,5 @@ impl Frame {
         self.rays = rays;
         self.engine = Engine::Book;
         self.packets = Packets::Off;
-        self.book_paths = 0;
     }
 }

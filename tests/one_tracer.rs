@@ -30,7 +30,7 @@ fn a_default_render_follows_every_path_through_the_books_trace() {
             );
             // At the `rays` stage `pixel` colours the direction and traces nothing.
             let paths = if stage == Stage::Rays { 0 } else { pixels };
-            assert_eq!(frame.book_paths, paths, "{stage}: one book path per pixel");
+            assert_eq!(frame.rays.paths, paths, "{stage}: one book path per pixel");
         }
     }
     // Samples are traced by the book too: the centre ray and four samples.
@@ -38,7 +38,7 @@ fn a_default_render_follows_every_path_through_the_books_trace() {
         spp: 4,
         ..Settings::from(Stages::ALL)
     };
-    assert_eq!(render(&scene, &spp, &|_| {}).book_paths, 5 * pixels);
+    assert_eq!(render(&scene, &spp, &|_| {}).rays.paths, 5 * pixels);
 }
 
 #[test]
@@ -50,7 +50,7 @@ fn the_fast_engine_leaves_the_books_trace_except_where_it_falls_back() {
     let frame = render(&common::seed(48, 32), &settings, &|_| {});
     assert_eq!(frame.engine, Engine::Fast);
     assert_ne!(frame.packets, Packets::Off);
-    assert_eq!(frame.book_paths, 0, "the packets trace every pixel");
+    assert_eq!(frame.rays.paths, 0, "the packets trace every pixel");
     // More objects than the packets' masks hold, and no BVH: the book's loop.
     let mut many = raystep::tools::generate::scene(80, 2);
     (many.width, many.height) = (24, 16);
@@ -61,7 +61,7 @@ fn the_fast_engine_leaves_the_books_trace_except_where_it_falls_back() {
     let frame = render(&many, &plain, &|_| {});
     assert_eq!(frame.packets, Packets::Off);
     assert_eq!(
-        frame.book_paths,
+        frame.rays.paths,
         24 * 16,
         "the fallback is the book's engine"
     );

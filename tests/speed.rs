@@ -222,7 +222,7 @@ fn the_fast_engine_gives_the_book_engines_bits_on_every_scene() {
                 0
             };
             assert_eq!(
-                book.book_paths, paths,
+                book.rays.paths, paths,
                 "{name}, {what}: the book engine follows every path"
             );
             // The packet tracer's plain x86-64 (SSE2) build, and its AVX build where
@@ -233,7 +233,7 @@ fn the_fast_engine_gives_the_book_engines_bits_on_every_scene() {
             ] {
                 if fast.packets != Packets::Off {
                     assert_eq!(
-                        fast.book_paths, 0,
+                        fast.rays.paths, 0,
                         "{name}, {what}: packets follow no book path"
                     );
                 }

@@ -142,6 +142,4 @@ fn render_in<T: Laned>(
         (true, false) => Packets::Baseline,
         (true, true) => Packets::Avx,
     };
-    // The fallback follows the book's paths; packets do not.
-    frame.book_paths = rays.paths;
 }
