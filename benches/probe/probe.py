@@ -39,13 +39,18 @@ for path, anchor, f in sorted(inc):
             i = j
         i += 1
 def run(args):
-    out = tempfile.mktemp(prefix="cg.probe.")
-    d = tempfile.mkdtemp()
-    subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", "--compress-strings=no",
-                    "--compress-pos=no", "--dump-instr=yes", BIN, "render"] + args + ["--width", "64", "--height", "36", "-q",
-                    "--out", d], check=True, capture_output=True)
+    # The callgrind file and the render's pictures go to a folder of their own,
+    # removed when the run has been read.
+    with tempfile.TemporaryDirectory(prefix="raystep-probe.") as d:
+        out = os.path.join(d, "callgrind.out")
+        pictures = os.path.join(d, "out")
+        subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", "--compress-strings=no",
+                        "--compress-pos=no", "--dump-instr=yes", BIN, "render"] + args + ["--width", "64", "--height", "36", "-q",
+                        "--out", pictures], check=True, capture_output=True)
+        with open(out) as f:
+            profile = f.read().split("\n")
     addrs = set(); ob = None; skip = False
-    for l in open(out):
+    for l in profile:
         if l.startswith("ob="):
             ob = l[3:].strip(); continue
         if l.startswith("calls="):
