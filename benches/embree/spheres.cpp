@@ -7,7 +7,8 @@
 // What it traces, as raystep's `Tracer::trace` does (chapter 6): one primary ray
 // per pixel through the tutorial's screen; at each hit, the normal, the point
 // stepped off the surface by raystep's `auto` offset, a shadow ray to the light
-// (any hit closer than the light ends the path), Blinn-Phong seen from the
+// unless the point faces away from it (then, as with any hit closer than the
+// light, the path ends), Blinn-Phong seen from the
 // camera, and a mirrored ray, up to `max_depth` segments, with raystep's early
 // stop (a path ends once nothing the rest of it can add would move a channel by
 // half an 8-bit step). The spheres (the floor's huge sphere too) are one Embree
@@ -244,7 +245,9 @@ struct Counts {
 
 constexpr int W = 8;  // rays per packet
 constexpr float HALF_STEP = 0.5f / 255.0f;
-constexpr float AUTO_FACTOR = 8.0f;                 // raystep's auto offset
+constexpr float RADIUS_UNITS = 7.0f;  // raystep's auto step: u·(7·r + 2·‖P‖)
+constexpr float POINT_UNITS = 2.0f;
+constexpr float STEP_CAP = 1e38f;     // raystep's STEP_CAP
 constexpr float U32 = 5.9604645e-8f;                // float32's unit roundoff
 
 struct Renderer {
@@ -340,11 +343,21 @@ struct Renderer {
         V d{rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]};
         point[k] = o + d * rh.ray.tfar[k];
         normal[k] = normalize(point[k] - b.centre);
-        V on_surface = b.centre + normal[k] * b.radius;
-        float scale = std::max(max_abs(b.centre) + b.radius, max_abs(on_surface));
-        shifted[k] = on_surface + normal[k] * (AUTO_FACTOR * U32 * scale);
+        // raystep's `auto` step (`sphere_step`, chapter 9): back onto the
+        // sphere and out by u·(7·r + 2·‖P‖), in one move.
+        V from_centre = point[k] - b.centre;
+        float back = b.radius - std::sqrt(dot(from_centre, from_centre));
+        float height = U32 * (RADIUS_UNITS * b.radius +
+                              POINT_UNITS * std::sqrt(dot(point[k], point[k])));
+        shifted[k] = point[k] + normal[k] * (back + std::min(height, STEP_CAP));
         V l = s.light - shifted[k];
         to_light[k] = normalize(l);
+        if (dot(normal[k], to_light[k]) < 0) {
+          // Its own sphere hides the light (raystep's `own_shadow`): the path
+          // ends, black, and no shadow ray is cast.
+          alive[k] = false;
+          continue;
+        }
         V lp = s.light - point[k];
         light_distance[k] = std::sqrt(dot(lp, lp));
         shadow.org_x[k] = shifted[k].x;
