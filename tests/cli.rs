@@ -509,6 +509,40 @@ fn diff_exits_0_same_1_different_2_trouble_with_a_threshold() {
     assert_eq!(code(&["diff", "a/buffers.exr"]), Some(2));
 }
 
+/// Issue 22's bound: a 1920 × 1080 render with every buffer (twelve pictures
+/// and the EXR of 26 channels) peaks at or under 150 MB (10⁶ bytes), as
+/// `render --json` reports it from `/proc` (125.8 MB with a release build on
+/// 2026-12-06; the frame of records alone is 108 MB).
+#[test]
+fn a_1080p_render_with_every_buffer_peaks_at_or_under_150_mb() {
+    let proc_status = std::path::Path::new("/proc/self/status")
+        .is_file()
+        .then_some(())
+        .ok_or_else(|| "/proc/self/status (Linux)".to_string());
+    if common::required(proc_status, "the peak memory test").is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = raystep(
+        dir.path(),
+        &[
+            "render", "--width", "1920", "--height", "1080", "-o", "o", "--json", "-q",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["files"].as_array().unwrap().len(), 13, "{report}");
+    let peak = report["peak_memory_bytes"]
+        .as_u64()
+        .expect("a peak on Linux");
+    let frame = 1920 * 1080 * raystep::aov::RECORD_BYTES as u64;
+    assert!(
+        peak > frame,
+        "the frame alone is {frame} bytes; peak {peak}"
+    );
+    assert!(peak <= 150_000_000, "peak {peak} bytes, over 150 MB");
+}
+
 #[test]
 fn json_outputs_carry_schema_1_and_the_documented_fields() {
     let dir = tempfile::tempdir().unwrap();
@@ -548,6 +582,7 @@ fn json_outputs_carry_schema_1_and_the_documented_fields() {
             "buffers",
             "seconds",
             "rays",
+            "peak_memory_bytes",
         ],
     );
     let files = render["files"].as_array().unwrap();

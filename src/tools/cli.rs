@@ -348,6 +348,7 @@ fn render_one(args: RenderArgs) -> Result<(), Error> {
                     "reflection": frame.rays.reflection,
                     "total": frame.rays.total(),
                 },
+                "peak_memory_bytes": crate::tools::bench::peak_memory_bytes(),
             }),
             true,
         )?;
