@@ -342,10 +342,10 @@ struct Renderer {
         V o{rh.ray.org_x[k], rh.ray.org_y[k], rh.ray.org_z[k]};
         V d{rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]};
         point[k] = o + d * rh.ray.tfar[k];
-        normal[k] = normalize(point[k] - b.centre);
+        V from_centre = point[k] - b.centre;
+        normal[k] = normalize(from_centre);
         // raystep's `auto` step (`sphere_step`, chapter 9): back onto the
         // sphere and out by u·(7·r + 2·‖P‖), in one move.
-        V from_centre = point[k] - b.centre;
         float back = b.radius - std::sqrt(dot(from_centre, from_centre));
         float height = U32 * (RADIUS_UNITS * b.radius +
                               POINT_UNITS * std::sqrt(dot(point[k], point[k])));
