@@ -5,6 +5,7 @@
 //! in range) and every mistake is reported with the file, the key and what would be
 //! valid.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use serde::Deserialize;
@@ -1117,8 +1118,10 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
         ));
     }
     let light = scene.light.position;
-    let mut warnings = Vec::new();
-    let mut spheres = Vec::new();
+    let (mut coarse, mut twins) = (Told::default(), Told::default());
+    // Each sphere as float32 rounds it (bits, -0 made +0, so that equal numbers
+    // are equal keys), and the first object that rounds so.
+    let mut rounded_to: HashMap<[u32; 4], usize> = HashMap::new();
     for (i, object) in scene.objects.iter().enumerate() {
         let at = format!("object number {} ({})", i + 1, describe(object));
         match &object.shape {
@@ -1130,36 +1133,80 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
                 let far = s.center + s.center.normalize_or(Vec3::X) * s.radius;
                 let band = pass_over(F32_U, s.radius, far);
                 if band > F32_TERMINATOR_WARNING {
-                    let step = sphere_height(far, s.radius, F32_U);
-                    warnings.push(format!(
-                        "{at}: its centre is {:.1e} radii from the origin; float32 places its \
-                         points to within {step:.1e} ({:.1e} of its radius), so its outline, \
-                         its normals and the rays that leave it are that coarse (a shadow ray \
-                         from there would pass over it up to |L·N| = {band:.2}); float64 (the \
-                         default precision) renders it to 1e-3",
-                        s.center.length() / s.radius,
-                        step / s.radius,
-                    ));
+                    coarse.most = coarse.most.max(band);
+                    coarse.tell(|| {
+                        let step = sphere_height(far, s.radius, F32_U);
+                        format!(
+                            "{at}: its centre is {:.1e} radii from the origin; float32 places \
+                             its points to within {step:.1e} ({:.1e} of its radius), so its \
+                             outline, its normals and the rays that leave it are that coarse (a \
+                             shadow ray from there would pass over it up to |L·N| = {band:.2}); \
+                             float64 (the default precision) renders it to 1e-3",
+                            s.center.length() / s.radius,
+                            step / s.radius,
+                        )
+                    });
                 }
-                let rounded = (s.center.as_vec3(), s.radius as f32);
-                if let Some(j) = spheres
-                    .iter()
-                    .position(|(other, _): &((glam::Vec3, f32), Sphere)| *other == rounded)
-                {
-                    warnings.push(format!(
-                        "{at} is object number {} in float32 (their centres and radii round to \
-                         the same numbers), so the first of the two is drawn; float64 (the \
-                         default precision) tells them apart",
-                        j + 1
-                    ));
+                let c = s.center.as_vec3();
+                let key = [c.x, c.y, c.z, s.radius as f32].map(|v| (v + 0.0).to_bits());
+                let first = *rounded_to.entry(key).or_insert(i);
+                if first != i {
+                    twins.tell(|| {
+                        format!(
+                            "{at} is object number {} in float32 (their centres and radii \
+                             round to the same numbers), so the first of the two is drawn; \
+                             float64 (the default precision) tells them apart",
+                            first + 1
+                        )
+                    });
                 }
-                spheres.push((rounded, *s));
             }
             Shape::Plane(plane) => lit_from_off(plane, &at, light, MIN_RADIUS_RATIO)
                 .map_err(|e| format!("{e}{to_f64}"))?,
         }
     }
+    let mut warnings = coarse.told;
+    if coarse.more > 0 {
+        warnings.push(format!(
+            "and {} more spheres that float32 places as coarsely (shadow rays passing over \
+             them up to |L·N| = {:.2} in all); float64 (the default precision) renders them \
+             to 1e-3",
+            coarse.more, coarse.most
+        ));
+    }
+    warnings.extend(twins.told);
+    if twins.more > 0 {
+        warnings.push(format!(
+            "and {} more spheres that float32 makes one with an earlier sphere, whose \
+             centres and radii round to the same numbers; float64 (the default precision) \
+             tells them apart",
+            twins.more
+        ));
+    }
     Ok(warnings)
+}
+
+/// Warnings of one kind: the first [`TOLD`] in full, then how many more.
+#[derive(Default)]
+struct Told {
+    told: Vec<String>,
+    more: usize,
+    /// The largest |L·N| band of the coarse spheres.
+    most: f64,
+}
+
+/// Warnings of one kind given in full; the rest are counted in one line (a
+/// scene of 100,000 small spheres would otherwise print one for each).
+const TOLD: usize = 5;
+
+impl Told {
+    fn tell(&mut self, message: impl FnOnce() -> String) {
+        if self.told.len() < TOLD {
+            self.told.push(message());
+        } else {
+            self.more += 1;
+        }
+    }
 }
 
 /// float32's unit roundoff.
@@ -1386,5 +1433,58 @@ mod tests {
                 proptest::prop_assert_eq!(raw.check(SizeOverride::default()), whole(&text), "{}", text);
             }
         }
+    }
+    /// A scene of many small spheres gets a few warnings in full and one line
+    /// counting the rest, for each kind, not one warning per sphere; a twin is
+    /// told which earlier sphere float32 makes it, as before.
+    #[test]
+    fn float32_warnings_are_counted_past_the_first_few() {
+        let mut text = String::from(HEAD);
+        // Twelve small spheres far from the origin for their size (2,000 radii).
+        for i in 0..12 {
+            text += &format!(
+                "\n[[sphere]]\ncenter = [{}, 0, -10]\nradius = 0.005\n",
+                f64::from(i) * 0.1 - 0.6
+            );
+        }
+        // Object 13, then eight spheres that float32 rounds to it.
+        text += "\n[[sphere]]\ncenter = [0, 0, -3]\nradius = 1\n";
+        for i in 1..=8 {
+            text += &format!(
+                "\n[[sphere]]\ncenter = [0, 0, -3]\nradius = {}\n",
+                1.0 + f64::from(i) * 1e-9
+            );
+        }
+        let scene = whole(&text).unwrap();
+        assert_eq!(check_precision(&scene, Precision::F64), Ok(vec![]));
+        let warnings = check_precision(&scene, Precision::F32).unwrap();
+        assert_eq!(warnings.len(), 2 * TOLD + 2, "{warnings:#?}");
+        assert!(
+            warnings.iter().all(|w| w.contains("float64")),
+            "{warnings:#?}"
+        );
+        assert!(
+            warnings[0].starts_with("object number 1 (a sphere"),
+            "{}",
+            warnings[0]
+        );
+        assert!(
+            warnings[TOLD].starts_with("and 7 more spheres that float32 places"),
+            "{}",
+            warnings[TOLD]
+        );
+        for (k, w) in warnings[TOLD + 1..2 * TOLD + 1].iter().enumerate() {
+            let number = 14 + k;
+            assert!(
+                w.starts_with(&format!("object number {number} ("))
+                    && w.contains("is object number 13 in float32"),
+                "{w}"
+            );
+        }
+        assert!(
+            warnings[2 * TOLD + 1].starts_with("and 3 more spheres that float32 makes one"),
+            "{}",
+            warnings[2 * TOLD + 1]
+        );
     }
 }
