@@ -257,3 +257,49 @@ fn explain_with_the_fast_engine_says_it_tells_the_book_tracers_story() {
     assert_eq!(quiet.stdout, book.stdout);
     assert!(!String::from_utf8_lossy(&quiet.stderr).contains(note));
 }
+
+/// In a scene of more than `LISTED` objects the story lists the objects a ray
+/// hits and counts the misses by their reason, so that every object is still
+/// accounted for; a small scene's story lists every test.
+#[test]
+fn a_story_among_many_spheres_counts_the_misses() {
+    use raystep::tools::explain::LISTED;
+    let settings = Settings::from(Stages::ALL);
+    let many = raystep::tools::generate::scene(200, 7);
+    let small: Scene = common::seed(200, 140);
+    for (scene, pixels) in [
+        (&many, [(40, 60), (10, 10), (80, 50)]),
+        (&small, [(74, 125), (10, 10), (50, 40)]),
+    ] {
+        let objects = scene.objects_in_play::<f64>(settings.stages).len();
+        for (x, y) in pixels {
+            let (x, y) = (x * scene.width / 100, y * scene.height / 140);
+            let story = explain(scene, &settings, x, y);
+            assert!(!story.segments.is_empty());
+            for segment in &story.segments {
+                let counted: usize = segment.unlisted.iter().map(|u| u.count).sum();
+                assert_eq!(segment.tests.len() + counted, objects, "pixel {x},{y}");
+                if objects > LISTED {
+                    assert!(counted > 0);
+                    assert!(
+                        segment.tests.iter().all(|t| t.t.is_some()),
+                        "{:?}",
+                        segment.tests
+                    );
+                    assert!(segment
+                        .unlisted
+                        .iter()
+                        .all(|u| u.verdict.starts_with("miss: ")));
+                    let text = story.to_string();
+                    for u in &segment.unlisted {
+                        let objects = if u.count == 1 { "object" } else { "objects" };
+                        let line = format!("  {} other {objects}\n    → {}\n", u.count, u.verdict);
+                        assert!(text.contains(&line), "{text}");
+                    }
+                } else {
+                    assert!(segment.unlisted.is_empty());
+                }
+            }
+        }
+    }
+}

@@ -667,6 +667,9 @@ function tell(story) {
     for (const test of segment.tests) {
       tests.append(element("li", `object ${test.object}, ${test.what}: ${test.verdict}`, "verdict"));
     }
+    for (const unlisted of segment.unlisted) {
+      tests.append(element("li", `${unlisted.count} other object${unlisted.count === 1 ? "" : "s"}: ${unlisted.verdict}`, "verdict"));
+    }
     box.append(tests);
     const hit = segment.hit;
     if (hit) {

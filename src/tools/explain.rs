@@ -89,10 +89,29 @@ pub struct Segment {
     pub ray: RayInfo,
     /// How much of this segment's light reaches the pixel.
     pub weight: f64,
-    /// The test of every object against the ray.
+    /// The test of every object against the ray; of a scene of more than
+    /// [`LISTED`] objects, only the objects the ray hits.
     pub tests: Vec<ObjectTest>,
+    /// Of a scene of more than [`LISTED`] objects, the misses left out of
+    /// `tests`, counted by their verdict (in the order of each verdict's first
+    /// object); empty otherwise.
+    pub unlisted: Vec<Unlisted>,
     /// The nearest object hit, if any.
     pub hit: Option<HitInfo>,
+}
+
+/// Scenes of at most this many objects have every object's test told; in
+/// larger ones (100,000 generated spheres would take 400,000 lines) the misses
+/// are counted by their reason.
+pub const LISTED: usize = 64;
+
+/// Misses of one kind left out of a segment's tests.
+#[derive(Clone, Debug, Serialize)]
+pub struct Unlisted {
+    /// Their verdict, e.g. `miss: Δ/4 < 0, the ray passes beside it`.
+    pub verdict: String,
+    /// How many objects had it.
+    pub count: usize,
 }
 
 /// The test of one object against one ray.
@@ -283,13 +302,31 @@ impl<T: Real> Observer<T> for Story<'_, T> {
     fn segment(&mut self, index: u32, ray: &Ray<T>, weight: T) {
         self.rays.segment(index, ray, weight);
         let (objects, method) = (&self.tracer.objects, self.tracer.method);
+        let mut tests: Vec<ObjectTest> = (objects.iter().enumerate())
+            .map(|(i, o)| test(i, o, ray, method))
+            .collect();
+        let mut unlisted: Vec<Unlisted> = Vec::new();
+        if tests.len() > LISTED {
+            tests.retain(|t| {
+                if t.t.is_some() {
+                    return true;
+                }
+                match unlisted.iter_mut().find(|u| u.verdict == t.verdict) {
+                    Some(u) => u.count += 1,
+                    None => unlisted.push(Unlisted {
+                        verdict: t.verdict.clone(),
+                        count: 1,
+                    }),
+                }
+                false
+            });
+        }
         self.told.segments.push(Segment {
             index,
             ray: info(ray),
             weight: weight.to_f64(),
-            tests: (objects.iter().enumerate())
-                .map(|(i, o)| test(i, o, ray, method))
-                .collect(),
+            tests,
+            unlisted,
             hit: None,
         });
     }
@@ -565,6 +602,10 @@ impl std::fmt::Display for Explanation {
                     write!(f, "; roots {}", roots.join(", "))?;
                 }
                 writeln!(f, "\n    → {}", t.verdict)?;
+            }
+            for u in &s.unlisted {
+                let objects = if u.count == 1 { "object" } else { "objects" };
+                writeln!(f, "  {} other {objects}\n    → {}", u.count, u.verdict)?;
             }
             let Some(h) = &s.hit else {
                 writeln!(f, "  nearest: nothing")?;
