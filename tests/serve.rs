@@ -372,6 +372,19 @@ fn the_scene_is_json_with_a_version_and_the_page_is_served() {
     assert_eq!(scene["scene"]["width"], 300);
     assert_eq!(scene["scene"]["objects"].as_array().unwrap().len(), 4);
     assert_eq!(scene["scene"]["objects"][0]["shape"]["radius"], 0.7);
+    assert_eq!(scene["scene"]["object_count"], 4);
+    assert_eq!(server.get("/api/scene?objects=all").json(), scene);
+    // What the page asks for: all but the list of objects.
+    let brief = server.get("/api/scene?objects=none").json();
+    assert_eq!(brief["scene"].get("objects"), None, "{brief}");
+    assert_eq!(brief["scene"]["object_count"], 4);
+    let mut full = scene.clone();
+    full["scene"].as_object_mut().unwrap().remove("objects");
+    assert_eq!(brief, full);
+    for bad in ["objects=some", "stage=shadow", "objects=none&objects=all"] {
+        let reply = server.get(&format!("/api/scene?{bad}"));
+        assert_eq!(reply.status, 400, "{bad}");
+    }
     let page = server.get("/");
     assert_eq!(page.status, 200);
     assert!(String::from_utf8_lossy(&page.body).contains("raystep studio"));

@@ -711,7 +711,7 @@ function tell(story) {
 }
 
 async function loadScene() {
-  const response = await fetch("/api/scene");
+  const response = await fetch("/api/scene?objects=none");
   const answer = await response.json();
   scene = answer.scene;
   $("scene-name").textContent = answer.file;

@@ -432,13 +432,10 @@ fn answer(shared: &Shared, request: Request) {
             PAGE_JS.into(),
             &[],
         ),
-        "/api/scene" => send(
-            request,
-            200,
-            JSON,
-            studio.scene_json().to_string().into_bytes(),
-            &[],
-        ),
+        "/api/scene" => match studio.scene_json(query) {
+            Ok(json) => send(request, 200, JSON, json.to_string().into_bytes(), &[]),
+            Err(refusal) => refuse(request, &refusal),
+        },
         "/api/pixel" => match studio.pixel(query) {
             Ok(json) => send(request, 200, JSON, json.into_bytes(), &[]),
             Err(refusal) => refuse(request, &refusal),
