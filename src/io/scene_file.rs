@@ -1434,6 +1434,7 @@ mod tests {
             }
         }
     }
+
     /// A scene of many small spheres gets a few warnings in full and one line
     /// counting the rest, for each kind, not one warning per sphere; a twin is
     /// told which earlier sphere float32 makes it, as before.

@@ -302,24 +302,22 @@ impl<T: Real> Observer<T> for Story<'_, T> {
     fn segment(&mut self, index: u32, ray: &Ray<T>, weight: T) {
         self.rays.segment(index, ray, weight);
         let (objects, method) = (&self.tracer.objects, self.tracer.method);
-        let mut tests: Vec<ObjectTest> = (objects.iter().enumerate())
-            .map(|(i, o)| test(i, o, ray, method))
-            .collect();
-        let mut unlisted: Vec<Unlisted> = Vec::new();
-        if tests.len() > LISTED {
-            tests.retain(|t| {
-                if t.t.is_some() {
-                    return true;
-                }
-                match unlisted.iter_mut().find(|u| u.verdict == t.verdict) {
-                    Some(u) => u.count += 1,
-                    None => unlisted.push(Unlisted {
-                        verdict: t.verdict.clone(),
-                        count: 1,
-                    }),
-                }
-                false
-            });
+        let (mut tests, mut unlisted) = (Vec::new(), Vec::<Unlisted>::new());
+        let every = objects.len() <= LISTED;
+        for (i, object) in objects.iter().enumerate() {
+            let mut test = judge(i, object, ray, method);
+            if every || test.t.is_some() {
+                test.what = what(object);
+                tests.push(test);
+                continue;
+            }
+            match unlisted.iter_mut().find(|u| u.verdict == test.verdict) {
+                Some(u) => u.count += 1,
+                None => unlisted.push(Unlisted {
+                    verdict: test.verdict,
+                    count: 1,
+                }),
+            }
         }
         self.told.segments.push(Segment {
             index,
@@ -425,13 +423,10 @@ impl<T: Real> Observer<T> for Story<'_, T> {
     }
 }
 
-/// The test of object `index` against `ray`, with its numbers and verdict.
-fn test<T: Real>(index: usize, object: &Object<T>, ray: &Ray<T>, method: Method) -> ObjectTest {
+/// The test of object `index` against `ray`, with its numbers and verdict, but
+/// not yet what the object is (`what` is empty: [`what`] gives it).
+fn judge<T: Real>(index: usize, object: &Object<T>, ray: &Ray<T>, method: Method) -> ObjectTest {
     let t = object.intersect(ray, method).map(Real::to_f64);
-    let role = match object.role {
-        Role::Sphere => "",
-        Role::Floor => " (the floor)",
-    };
     match &object.shape {
         Shape::Sphere(s) => {
             let (discriminant, roots) = match method {
@@ -458,11 +453,7 @@ fn test<T: Real>(index: usize, object: &Object<T>, ray: &Ray<T>, method: Method)
             };
             ObjectTest {
                 object: index,
-                what: format!(
-                    "sphere{role}, centre {}, radius {}",
-                    vector(s.center.to_f64()),
-                    num(s.radius.to_f64())
-                ),
+                what: String::new(),
                 discriminant: Some(d),
                 roots,
                 t,
@@ -479,11 +470,7 @@ fn test<T: Real>(index: usize, object: &Object<T>, ray: &Ray<T>, method: Method)
             };
             ObjectTest {
                 object: index,
-                what: format!(
-                    "plane{role}, through {}, normal {}",
-                    vector(p.point.to_f64()),
-                    vector(p.normal.to_f64())
-                ),
+                what: String::new(),
                 discriminant: None,
                 roots: if facing == 0.0 {
                     Vec::new()
@@ -494,6 +481,26 @@ fn test<T: Real>(index: usize, object: &Object<T>, ray: &Ray<T>, method: Method)
                 verdict,
             }
         }
+    }
+}
+
+/// What `object` is, as a test names it: `sphere, centre (…), radius 0.7`.
+fn what<T: Real>(object: &Object<T>) -> String {
+    let role = match object.role {
+        Role::Sphere => "",
+        Role::Floor => " (the floor)",
+    };
+    match &object.shape {
+        Shape::Sphere(s) => format!(
+            "sphere{role}, centre {}, radius {}",
+            vector(s.center.to_f64()),
+            num(s.radius.to_f64())
+        ),
+        Shape::Plane(p) => format!(
+            "plane{role}, through {}, normal {}",
+            vector(p.point.to_f64()),
+            vector(p.normal.to_f64())
+        ),
     }
 }
 
