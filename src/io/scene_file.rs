@@ -1082,7 +1082,12 @@ fn placed(
 /// Refuse a light on a true plane (within `ratio` of the scene's size of it): the
 /// plane would be lit edge-on, and a point of it could be the light itself, from
 /// which no direction leads to the light.
-fn lit_from_off(plane: &Plane, at: &str, light: Vec3, ratio: f64) -> Result<(), String> {
+fn lit_from_off(
+    plane: &Plane,
+    at: &dyn std::fmt::Display,
+    light: Vec3,
+    ratio: f64,
+) -> Result<(), String> {
     let size = light
         .abs()
         .max_element()
@@ -1119,11 +1124,15 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
     }
     let light = scene.light.position;
     let (mut coarse, mut twins) = (Told::default(), Told::default());
+    // The largest |L·N| band of the coarse spheres.
+    let mut coarsest = 0.0f64;
     // Each sphere as float32 rounds it (bits, -0 made +0, so that equal numbers
     // are equal keys), and the first object that rounds so.
     let mut rounded_to: HashMap<[u32; 4], usize> = HashMap::new();
     for (i, object) in scene.objects.iter().enumerate() {
-        let at = format!("object number {} ({})", i + 1, describe(object));
+        // Written out only in a message, as the loader does (100,000 spheres
+        // would otherwise make as many strings).
+        let at = Lazy(|| format!("object number {} ({})", i + 1, describe(object)));
         match &object.shape {
             Shape::Sphere(s) => {
                 placed(s, &at, scene.camera, light, MIN_RADIUS_RATIO)
@@ -1133,7 +1142,7 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
                 let far = s.center + s.center.normalize_or(Vec3::X) * s.radius;
                 let band = pass_over(F32_U, s.radius, far);
                 if band > F32_TERMINATOR_WARNING {
-                    coarse.most = coarse.most.max(band);
+                    coarsest = coarsest.max(band);
                     coarse.tell(|| {
                         let step = sphere_height(far, s.radius, F32_U);
                         format!(
@@ -1171,7 +1180,7 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
             "and {} more spheres that float32 places as coarsely (shadow rays passing over \
              them up to |L·N| = {:.2} in all); float64 (the default precision) renders them \
              to 1e-3",
-            coarse.more, coarse.most
+            coarse.more, coarsest
         ));
     }
     warnings.extend(twins.told);
@@ -1191,8 +1200,6 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
 struct Told {
     told: Vec<String>,
     more: usize,
-    /// The largest |L·N| band of the coarse spheres.
-    most: f64,
 }
 
 /// Warnings of one kind given in full; the rest are counted in one line (a
