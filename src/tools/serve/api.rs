@@ -818,8 +818,29 @@ pub struct Rendered {
 pub fn describe_scene(scene: &Scene, listed: bool) -> Value {
     let camera = scene.camera();
     let s = camera.screen;
-    let shown = if listed { scene.objects.len() } else { 0 };
-    let objects: Vec<Value> = scene.objects[..shown]
+    let l = &scene.light;
+    let mut described = json!({
+        "width": scene.width,
+        "height": scene.height,
+        "camera": scene.camera.to_array(),
+        "screen": {
+            "left": s.left, "right": s.right, "top": s.top, "bottom": s.bottom,
+            "set_by_scene": scene.screen.is_some(),
+        },
+        "light": {
+            "position": l.position.to_array(),
+            "ambient": l.ambient.to_array(),
+            "diffuse": l.diffuse.to_array(),
+            "specular": l.specular.to_array(),
+        },
+        "max_depth": scene.max_depth,
+        "object_count": scene.objects.len(),
+    });
+    if !listed {
+        return described;
+    }
+    let objects: Vec<Value> = scene
+        .objects
         .iter()
         .enumerate()
         .map(|(index, o)| {
@@ -846,29 +867,6 @@ pub fn describe_scene(scene: &Scene, listed: bool) -> Value {
             json!({ "index": index, "section": section, "shape": shape, "material": material })
         })
         .collect();
-    let l = &scene.light;
-    let mut described = json!({
-        "width": scene.width,
-        "height": scene.height,
-        "camera": scene.camera.to_array(),
-        "screen": {
-            "left": s.left, "right": s.right, "top": s.top, "bottom": s.bottom,
-            "set_by_scene": scene.screen.is_some(),
-        },
-        "light": {
-            "position": l.position.to_array(),
-            "ambient": l.ambient.to_array(),
-            "diffuse": l.diffuse.to_array(),
-            "specular": l.specular.to_array(),
-        },
-        "max_depth": scene.max_depth,
-        "object_count": scene.objects.len(),
-        "objects": objects,
-    });
-    if !listed {
-        if let Some(fields) = described.as_object_mut() {
-            fields.remove("objects");
-        }
-    }
+    described["objects"] = Value::Array(objects);
     described
 }
