@@ -152,9 +152,27 @@ fn check_describes_the_scene() {
         "spheres: 3",
         "radius 8999.3",
         "planes:  1",
+        // Numbered as explain, the studio and the object buffer number them:
+        // from 0, spheres first, so the floor is object 3.
+        "    object 0: sphere at [-0.2, 0, -1], radius 0.7\n",
+        "    object 3: sphere at [0, -9000, 0], radius 8999.3\n",
     ] {
         assert!(stdout.contains(expected), "{expected:?} in\n{stdout}");
     }
+}
+
+#[test]
+fn chapter_one_shows_what_check_prints() {
+    // The chapter's transcript of `raystep check scenes/seed.toml`, run from the
+    // repository's root, is the command's output as it is now.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let chapter = std::fs::read_to_string(root.join("chapters/01-scene.md")).unwrap();
+    let command = "$ raystep check scenes/seed.toml\n";
+    let start = chapter.find(command).expect("chapter 1 shows raystep check") + command.len();
+    let shown = &chapter[start..start + chapter[start..].find("```").unwrap()];
+    let out = raystep(root, &["check", "scenes/seed.toml"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(shown, text(&out.stdout));
 }
 
 #[test]
@@ -172,19 +190,24 @@ fn check_counts_the_spheres_past_the_first_twenty() {
     let listed = |stdout: &str| {
         stdout
             .lines()
-            .filter(|l| l.trim_start().split_once(". sphere at").is_some())
+            .filter(|l| l.starts_with("    object ") && l.contains(": sphere at"))
             .count()
     };
     let short = text(&raystep(dir.path(), &["check", "thirty.toml"]).stdout);
     assert!(short.contains("spheres: 30"), "{short}");
-    assert!(short.contains("    20. sphere at"), "{short}");
-    assert!(!short.contains("    21. sphere at"), "{short}");
+    assert!(short.contains("    object 19: sphere at"), "{short}");
+    assert!(!short.contains("    object 20: sphere at"), "{short}");
     assert!(
         short.contains("… and 10 more (raystep check --all"),
         "{short}"
     );
-    // The floor is the one plane, listed after the count of the spheres.
+    // The floor is the one plane, listed after the count of the spheres, under
+    // its own number: object 30, after spheres 0 to 29.
     assert_eq!(listed(&short), 21, "{short}");
+    assert!(
+        short.contains("    object 30: sphere at [0, -9000, 0]"),
+        "{short}"
+    );
     let all = text(&raystep(dir.path(), &["check", "thirty.toml", "--all"]).stdout);
     assert_eq!(listed(&all), 31, "{all}");
     assert!(!all.contains("more (raystep check --all"), "{all}");

@@ -1132,11 +1132,19 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
     for (i, object) in scene.objects.iter().enumerate() {
         // Written out only in a message, as the loader does (100,000 spheres
         // would otherwise make as many strings).
-        let at = Lazy(|| format!("object number {} ({})", i + 1, describe(object)));
+        // Under the number explain, the studio and the `object` buffer give it.
+        let at = Lazy(|| format!("object {i} ({})", describe(object)));
         match &object.shape {
             Shape::Sphere(s) => {
-                placed(s, &at, scene.camera, light, MIN_RADIUS_RATIO)
-                    .map_err(|e| format!("{e}{to_f64}"))?;
+                // `placed` gives the centre and radius itself where it needs them.
+                placed(
+                    s,
+                    &Lazy(|| format!("object {i}")),
+                    scene.camera,
+                    light,
+                    MIN_RADIUS_RATIO,
+                )
+                .map_err(|e| format!("{e}{to_f64}"))?;
                 // At the sphere's point farthest from the origin, where the step
                 // is longest.
                 let far = s.center + s.center.normalize_or(Vec3::X) * s.radius;
@@ -1162,10 +1170,9 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
                 if first != i {
                     twins.tell(|| {
                         format!(
-                            "{at} is object number {} in float32 (their centres and radii \
+                            "{at} is object {first} in float32 (their centres and radii \
                              round to the same numbers), so the first of the two is drawn; \
-                             float64 (the default precision) tells them apart",
-                            first + 1
+                             float64 (the default precision) tells them apart"
                         )
                     });
                 }
@@ -1472,7 +1479,7 @@ mod tests {
             "{warnings:#?}"
         );
         assert!(
-            warnings[0].starts_with("object number 1 (a sphere"),
+            warnings[0].starts_with("object 0 (a sphere"),
             "{}",
             warnings[0]
         );
@@ -1482,10 +1489,10 @@ mod tests {
             warnings[TOLD]
         );
         for (k, w) in warnings[TOLD + 1..2 * TOLD + 1].iter().enumerate() {
-            let number = 14 + k;
+            let number = 13 + k;
             assert!(
-                w.starts_with(&format!("object number {number} ("))
-                    && w.contains("is object number 13 in float32"),
+                w.starts_with(&format!("object {number} ("))
+                    && w.contains("is object 12 in float32"),
                 "{w}"
             );
         }

@@ -807,7 +807,8 @@ pub const LISTED: usize = 20;
 
 /// A readable summary of a checked scene, as `raystep check` prints it: every
 /// object, or with `listed = Some(n)` the first `n` of each kind and a line that
-/// counts the others.
+/// counts the others. Objects are numbered from 0, spheres first, as
+/// `explain`, the studio and the `object` buffer number them.
 pub fn describe(scene: &Scene, name: &str, listed: Option<usize>) -> String {
     let mut out = format!("{name}: a valid scene\n");
     let cam = scene.camera();
@@ -831,8 +832,12 @@ pub fn describe(scene: &Scene, name: &str, listed: Option<usize>) -> String {
         "  light    at {}; ambient {}, diffuse {}, specular {}\n",
         l.position, l.ambient, l.diffuse, l.specular
     );
+    // Each object under the number explain, the studio and the `object` buffer
+    // give it: its index among the scene's objects, spheres first.
     for role in [Role::Sphere, Role::Floor] {
-        let objects: Vec<_> = scene.objects.iter().filter(|o| o.role == role).collect();
+        let objects: Vec<_> = (scene.objects.iter().enumerate())
+            .filter(|(_, o)| o.role == role)
+            .collect();
         let heading = match role {
             Role::Sphere => "spheres:",
             Role::Floor => "planes: ",
@@ -843,15 +848,14 @@ pub fn describe(scene: &Scene, name: &str, listed: Option<usize>) -> String {
         };
         out += &format!("  {heading} {}{note}\n", objects.len());
         let shown = listed.unwrap_or(usize::MAX).min(objects.len());
-        for (i, o) in objects.iter().enumerate().take(shown) {
+        for &(id, o) in objects.iter().take(shown) {
             let shape = match o.shape {
                 Shape::Sphere(sp) => format!("sphere at {}, radius {}", sp.center, sp.radius),
                 Shape::Plane(p) => format!("true plane through {}, normal {}", p.point, p.normal),
             };
             let m = &o.material;
             out += &format!(
-                "    {}. {shape}\n       ambient {}, diffuse {}, specular {}, shininess {}, reflection {}\n",
-                i + 1,
+                "    object {id}: {shape}\n      ambient {}, diffuse {}, specular {}, shininess {}, reflection {}\n",
                 m.ambient,
                 m.diffuse,
                 m.specular,
