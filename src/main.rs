@@ -9,7 +9,23 @@ use raystep::tools::args::Cli;
 use raystep::tools::cli::execute;
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // `--help` and `--version` (on standard output), or a mistake in the
+        // flags (on standard error, exit 2). Help that cannot be written (a full
+        // disk) is an error, as for any output; a closed pipe is not.
+        Err(e) => {
+            use std::io::Write;
+            let printed = e.print().and_then(|()| std::io::stdout().flush());
+            return match printed {
+                Err(io) if io.kind() != std::io::ErrorKind::BrokenPipe => {
+                    eprintln!("error: cannot write standard output: {io}");
+                    ExitCode::from(2)
+                }
+                _ => ExitCode::from(e.exit_code() as u8),
+            };
+        }
+    };
     raystep::interrupt::install();
     match execute(cli) {
         Ok(code) => ExitCode::from(code),

@@ -168,7 +168,10 @@ fn chapter_one_shows_what_check_prints() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let chapter = std::fs::read_to_string(root.join("chapters/01-scene.md")).unwrap();
     let command = "$ raystep check scenes/seed.toml\n";
-    let start = chapter.find(command).expect("chapter 1 shows raystep check") + command.len();
+    let start = chapter
+        .find(command)
+        .expect("chapter 1 shows raystep check")
+        + command.len();
     let shown = &chapter[start..start + chapter[start..].find("```").unwrap()];
     let out = raystep(root, &["check", "scenes/seed.toml"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
@@ -286,6 +289,12 @@ fn diff_compares_two_renders_and_refuses_two_sizes() {
         "{}",
         text(&same.stdout)
     );
+    // No place is named for the largest of no differences.
+    assert!(
+        text(&same.stdout).contains("largest difference:        0 (the images are the same)\n"),
+        "{}",
+        text(&same.stdout)
+    );
 
     let other = run(&["diff", "a/buffers.exr", "b/buffers.exr"]);
     assert_eq!(
@@ -294,6 +303,7 @@ fn diff_compares_two_renders_and_refuses_two_sizes() {
         "different: exit 1, as diff and cmp"
     );
     assert!(!text(&other.stdout).contains("differ by more than 1/255: 0 pixels"));
+    assert!(text(&other.stdout).contains("largest difference:        0."));
 
     let sizes = run(&["diff", "a/buffers.exr", "small/buffers.exr"]);
     assert_eq!(sizes.status.code(), Some(2));

@@ -638,6 +638,9 @@ fn output_that_cannot_be_written_is_an_error_and_a_closed_pipe_is_not() {
     std::fs::write(dir.path().join("ok.toml"), OK_SCENE).unwrap();
     for args in [
         &["generate", "spheres", "--count", "100"][..],
+        &["--help"],
+        &["--version"],
+        &["render", "--help"],
         &["check", "ok.toml"],
         &["explain", "ok.toml", "--pixel", "1,1", "--json"],
         &["explain", "ok.toml", "--pixel", "1,1"],

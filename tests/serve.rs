@@ -30,16 +30,22 @@ impl Server {
 
     /// [`Server::start`] in the folder `dir` (a relative `scene` is in it).
     fn start_in(dir: Option<&Path>, scene: Option<&Path>) -> Server {
-        Server::start_with(dir, scene, Stdio::null())
+        Server::start_with(dir, scene, Stdio::null(), &[])
     }
 
-    /// [`Server::start_in`], its standard error to `stderr`.
-    fn start_with(dir: Option<&Path>, scene: Option<&Path>, stderr: Stdio) -> Server {
+    /// [`Server::start_in`], its standard error to `stderr`, with the options
+    /// `extra` after `serve`.
+    fn start_with(
+        dir: Option<&Path>,
+        scene: Option<&Path>,
+        stderr: Stdio,
+        extra: &[&str],
+    ) -> Server {
         let mut command = Command::new(env!("CARGO_BIN_EXE_raystep"));
         if let Some(dir) = dir {
             command.current_dir(dir);
         }
-        command.arg("serve");
+        command.arg("serve").args(extra);
         if let Some(scene) = scene {
             command.arg(scene);
         }
@@ -1138,11 +1144,8 @@ fn load_of_1000_requests_from_50_clients_is_answered_and_the_server_stays_up() {
     assert_eq!(server.get("/api/render?width=60&height=40").status, 200);
 }
 
-#[test]
-fn ctrl_c_stops_the_server_with_exit_code_130() {
-    let log = tempfile::NamedTempFile::new().unwrap();
-    let mut server = Server::start_with(None, None, log.reopen().unwrap().into());
-    assert_eq!(server.get("/api/scene").status, 200);
+/// Stop `server` as Ctrl-C does, and wait for it to end: its exit code.
+fn interrupt(server: &mut Server) -> Option<i32> {
     let pid = server.child.id().to_string();
     let kill = Command::new("kill").args(["-INT", &pid]).status().unwrap();
     assert!(kill.success());
@@ -1154,16 +1157,40 @@ fn ctrl_c_stops_the_server_with_exit_code_130() {
         assert!(Instant::now() < deadline, "still running after Ctrl-C");
         std::thread::sleep(Duration::from_millis(20));
     };
-    assert_eq!(status.code(), Some(130));
+    status.code()
+}
+
+#[test]
+fn ctrl_c_stops_the_server_with_exit_code_130() {
+    let log = tempfile::NamedTempFile::new().unwrap();
+    let mut server = Server::start_with(None, None, log.reopen().unwrap().into(), &[]);
+    assert_eq!(server.get("/api/scene").status, 200);
+    assert_eq!(interrupt(&mut server), Some(130));
     assert!(
         TcpStream::connect(("127.0.0.1", server.port)).is_err(),
         "closed"
     );
     // It says it stopped, not what a render interrupted says (it wrote nothing).
     let said = std::fs::read_to_string(log.path()).unwrap();
+    assert!(said.starts_with("serving scenes/seed.toml (built in) on http://127.0.0.1:"));
     assert!(
         said.ends_with("interrupted: the studio stopped (every answer under way was finished)\n"),
         "{said}"
+    );
+}
+
+#[test]
+fn quiet_leaves_out_the_serving_line() {
+    // -q silences status lines, the studio's address on standard error among
+    // them (standard output still gives it, for a script to read).
+    let log = tempfile::NamedTempFile::new().unwrap();
+    let mut server = Server::start_with(None, None, log.reopen().unwrap().into(), &["-q"]);
+    assert_eq!(server.get("/api/scene").status, 200);
+    assert_eq!(interrupt(&mut server), Some(130));
+    let said = std::fs::read_to_string(log.path()).unwrap();
+    assert_eq!(
+        said,
+        "error: interrupted: the studio stopped (every answer under way was finished)\n"
     );
 }
 

@@ -1046,8 +1046,8 @@ fn placed(
              camera, and at least {MIN_RADIUS:e}): {precision} would round its hit points by \
              a sizeable part of its size; make it larger or scale the whole scene",
             shown(s.radius),
-            shown(smallest),
-            ratio_shown(ratio),
+            six_digits(smallest),
+            six_digits(ratio),
             shown(size)
         ));
     }
@@ -1241,6 +1241,13 @@ fn describe(object: &Object) -> String {
 /// A limit's ratio as messages show it: `1e-6`, `1.9e-15`.
 fn ratio_shown(ratio: f64) -> String {
     format!("{ratio:.1e}").replace(".0e", "e")
+}
+
+/// A computed limit to six significant digits (`1.86265e-12`, `0.100001`), not
+/// the seventeen that make it exact (`0.10000099999999999`).
+fn six_digits(v: f64) -> String {
+    let rounded: f64 = format!("{v:.5e}").parse().unwrap_or(v);
+    shown(rounded)
 }
 
 /// `[x, y, z]` as a scene file writes it.

@@ -137,7 +137,7 @@ pub struct ChartArgs {
     #[arg(long)]
     pub scale: bool,
     /// With --scale, the largest count (powers of ten and their triples up to it).
-    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..=10_000_000))]
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..=10_000_000), requires = "scale")]
     pub max_count: u64,
     /// With --scale, also time the Embree program at PATH on each scene (built by
     /// `benches/embree/run.sh build`), drawn beside raystep's points.

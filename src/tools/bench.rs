@@ -376,12 +376,12 @@ impl Report {
         ));
         if let (Some(t), Some(s)) = (self.one_thread_median_s, self.thread_speedup) {
             line(format!(
-                "  1 thread    {t:>9.4} s per frame   {} threads are {s:.2}× faster",
+                "  1 thread    {t:>9.4} s per frame   {} threads are {s:.2}× as fast",
                 self.threads
             ));
             if let (Some(t), Some(s)) = (self.one_thread_trace_s, self.trace_thread_speedup) {
                 line(format!(
-                    "  1 thread    {t:>9.4} s of rows      {} threads are {s:.2}× faster on the rows",
+                    "  1 thread    {t:>9.4} s of rows      {} threads are {s:.2}× as fast on the rows",
                     self.threads
                 ));
             }

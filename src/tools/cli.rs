@@ -138,7 +138,7 @@ pub fn execute(cli: Cli) -> Result<u8, Error> {
         Some(Command::Accuracy(args)) => accuracy(&args),
         Some(Command::Bench(args)) => bench(args),
         Some(Command::Chart(args)) => chart(args),
-        Some(Command::Serve(args)) => crate::tools::serve::run(&args),
+        Some(Command::Serve(args)) => crate::tools::serve::run(&args, quiet()),
         Some(Command::Generate(args)) => match args.what {
             Generated::Spheres {
                 count,
@@ -252,9 +252,9 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
     pending.commit()?;
     bar.finish_and_clear();
     status!(
-        "wrote {} stages into {}/ in {:.2} s",
+        "wrote {} stages into {} in {:.2} s",
         Stage::ALL.len(),
-        args.out.display(),
+        folder(&args.out),
         start.elapsed().as_secs_f64()
     );
     status!(
@@ -376,7 +376,7 @@ fn write(
     bar.suspend(|| {
         status!(
             "  {:<28} {}   render {:.3} s, write {:.3} s",
-            format!("{}/", dir.display()),
+            folder(dir),
             names.join(" "),
             render_seconds,
             write_seconds
@@ -399,9 +399,7 @@ fn bench(mut args: BenchArgs) -> Result<(), Error> {
         threads,
         yardstick: !args.no_yardstick,
     };
-    if !args.json {
-        status!("{name}: {}", settings.stages);
-    }
+    status!("{name}: {}", settings.stages);
     let bar = counted_bar(u64::from(args.runs) + 1, "bench", "runs");
     let report = crate::tools::bench::bench(&scene, &settings, options, &|n| bar.inc(n))?;
     bar.finish_and_clear();
@@ -469,7 +467,8 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
             crate::tools::chart::write_scale(&mut pending, &args.out, "scale", &points, &title)?;
         pending.commit()?;
         say!("{}", csv.trim_end());
-        status!("wrote {}/scale.csv, {}", args.out.display(), names(&files));
+        let csv = args.out.join("scale.csv");
+        status!("wrote {}, {}", csv.display(), names(&files));
         return Ok(());
     }
     args.scene.default_size(960, 540);
@@ -493,8 +492,19 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
         crate::tools::chart::write_sweep(&mut pending, &args.out, "chart", &points, &title)?;
     pending.commit()?;
     say!("{}", csv.trim_end());
-    status!("wrote {}/chart.csv, {}", args.out.display(), names(&files));
+    let csv = args.out.join("chart.csv");
+    status!("wrote {}, {}", csv.display(), names(&files));
     Ok(())
+}
+
+/// A folder as status lines name it: with one `/` at the end, whether or not
+/// it was given with one.
+fn folder(dir: &Path) -> String {
+    let shown = dir.display().to_string();
+    match shown.ends_with('/') {
+        true => shown,
+        false => shown + "/",
+    }
 }
 
 fn names(files: &[PathBuf]) -> String {
@@ -622,12 +632,16 @@ fn diff(args: &DiffArgs) -> Result<u8, Error> {
         d.over_one_step,
         100.0 * d.over_one_step as f64 / d.pixels as f64
     );
-    say!(
-        "  largest difference:        {:.4} (row {}, column {})",
-        d.largest,
-        d.largest_at.0,
-        d.largest_at.1
-    );
+    match d.largest > 0.0 {
+        true => say!(
+            "  largest difference:        {:.4} (row {}, column {})",
+            d.largest,
+            d.largest_at.0,
+            d.largest_at.1
+        ),
+        // Where the largest of no differences lies would mean nothing.
+        false => say!("  largest difference:        0 (the images are the same)"),
+    }
     say!("  root mean square:          {:.6}", d.rmse);
     say!(
         "  clipped (a channel at 1):  {} and {} pixels",
@@ -714,11 +728,7 @@ fn figures(args: &FiguresArgs) -> Result<(), Error> {
         )));
     }
     let written = crate::tools::figures::write_all(root, &args.out, &render_command)?;
-    status!(
-        "wrote {} figures into {}/",
-        written.len(),
-        args.out.display()
-    );
+    status!("wrote {} figures into {}", written.len(), folder(&args.out));
     Ok(())
 }
 

@@ -70,8 +70,9 @@ const PAGE_POLICY: &str = "default-src 'none'; script-src 'self'; style-src 'sel
      img-src 'self' blob: data:; connect-src 'self'; base-uri 'none'; form-action 'none'; \
      frame-ancestors 'none'";
 
-/// Carry out `raystep serve`: listen, print the address, answer until Ctrl-C.
-pub fn run(args: &ServeArgs) -> Result<(), Error> {
+/// Carry out `raystep serve`: listen, print the address, answer until Ctrl-C;
+/// `quiet` (`-q`) leaves out the status line on standard error.
+pub fn run(args: &ServeArgs, quiet: bool) -> Result<(), Error> {
     let studio = Arc::new(Studio::open(args.scene.as_deref())?);
     let address = SocketAddr::from(([127, 0, 0, 1], args.port));
     let server = Server::http(address).map_err(|e| {
@@ -90,10 +91,12 @@ pub fn run(args: &ServeArgs) -> Result<(), Error> {
                 message: e.to_string(),
             })?;
     }
-    eprintln!(
-        "serving {} on {url} (127.0.0.1 only); Ctrl-C to stop",
-        studio.name()
-    );
+    if !quiet {
+        eprintln!(
+            "serving {} on {url} (127.0.0.1 only); Ctrl-C to stop",
+            studio.name()
+        );
+    }
     if args.open {
         open_browser(&url);
     }
