@@ -746,6 +746,36 @@ fn completions_and_a_man_page() {
         .find(|l| !l.starts_with(".ie") && !l.starts_with(".el"));
     assert!(first.unwrap().starts_with(".TH raystep 1"), "{page}");
     assert!(page.contains("render"), "{page}");
+    // The limits and exit codes are a table, kept as written (no filling).
+    let limits = page.split(".SH \"LIMITS AND EXIT CODES\"\n.nf\n").nth(1);
+    let limits = limits
+        .expect("a section of limits, not filled")
+        .split(".fi\n")
+        .next();
+    assert!(limits.unwrap().contains("\nExit codes: 0 done"), "{page}");
+    // Every page raystep's own page refers to is there: `raystep man COMMAND`.
+    let listed: Vec<&str> = page
+        .lines()
+        .filter_map(|l| l.strip_prefix("raystep\\-")?.strip_suffix("(1)"))
+        .collect();
+    assert_eq!(listed, raystep::tools::args::COMMANDS, "{page}");
+    for command in listed {
+        let man = raystep(dir.path(), &["man", command]);
+        assert!(man.status.success(), "{command}: {}", text(&man.stderr));
+        let page = text(&man.stdout);
+        assert!(
+            page.contains(&format!(".TH raystep-{command} 1 ")),
+            "{command}: {page}"
+        );
+        assert!(
+            page.contains(&format!("\\fBraystep {command}\\fR")),
+            "{page}"
+        );
+    }
+    assert_eq!(
+        raystep(dir.path(), &["man", "nothing"]).status.code(),
+        Some(2)
+    );
 }
 
 #[test]

@@ -50,6 +50,7 @@ Limits (a value beyond them is refused with a message, exit code 2):
                  written as a recipe ([generate] spheres = N, at most 1,000,000)
   chart --scale  a --max-count whose largest scene fits in 2.1 GB: about 750
                  bytes per sphere and 64 per pixel
+
 Exit codes: 0 done, 1 diff found the images different, 2 a mistake in the input
 or trouble, 130 interrupted (Ctrl-C: the files of the render before stay as they
 were).";
@@ -95,9 +96,32 @@ pub enum Command {
         #[arg(value_enum)]
         shell: clap_complete::Shell,
     },
-    /// Print the manual page (roff) to standard output, e.g. raystep man | man -l -
-    Man,
+    /// Print the manual page (roff) to standard output, e.g. raystep man | man -l -;
+    /// with a command, that command's page (raystep-render(1): raystep man render)
+    Man {
+        /// The command whose page to print (default: raystep's own page, which
+        /// lists the commands).
+        #[arg(value_parser = COMMANDS)]
+        command: Option<String>,
+    },
 }
+
+/// The commands that have a manual page of their own (`raystep man COMMAND`).
+pub const COMMANDS: [&str; 13] = [
+    "stages",
+    "render",
+    "explain",
+    "check",
+    "diff",
+    "figures",
+    "accuracy",
+    "bench",
+    "generate",
+    "chart",
+    "serve",
+    "completions",
+    "man",
+];
 
 /// Arguments of `raystep explain`.
 #[derive(Args, Debug)]

@@ -119,7 +119,7 @@ pub fn execute(cli: Cli) -> Result<u8, Error> {
                 | Command::Generate(_)
                 | Command::Bench(_)
                 | Command::Completions { .. }
-                | Command::Man
+                | Command::Man { .. }
         )
     ) {
         start_threads()?;
@@ -166,18 +166,83 @@ pub fn execute(cli: Cli) -> Result<u8, Error> {
             clap_complete::generate(shell, &mut Cli::command(), "raystep", &mut text);
             write_stdout(&text)
         }
-        Some(Command::Man) => {
-            let mut text = Vec::new();
-            clap_mangen::Man::new(Cli::command())
-                .render(&mut text)
-                .map_err(|e| Error::Output {
-                    path: "the manual page".into(),
-                    message: e.to_string(),
-                })?;
+        Some(Command::Man { command }) => {
+            let text = man_page(command.as_deref()).map_err(|e| Error::Output {
+                path: "the manual page".into(),
+                message: e.to_string(),
+            })?;
             write_stdout(&text)
         }
     }
     .map(|()| 0)
+}
+
+/// The manual page of raystep, or of `command` (`raystep-render(1)`, as raystep's
+/// page lists it), in roff.
+fn man_page(command: Option<&str>) -> std::io::Result<Vec<u8>> {
+    // `raystep help` has no page: the pages are the help.
+    let mut cli = Cli::command().disable_help_subcommand(true);
+    cli.build();
+    let page = match command {
+        None => cli,
+        Some(name) => cli
+            .find_subcommand(name)
+            .cloned()
+            .expect("COMMANDS names raystep's commands")
+            // (clap keeps a name for as long as the program runs, and this one
+            // ends once the page is printed.)
+            .name(&*format!("raystep-{name}").leak())
+            .version(env!("CARGO_PKG_VERSION")),
+    };
+    let limits = page.get_after_help().map(|text| text.to_string());
+    let man = clap_mangen::Man::new(page.clone().after_help(None::<&str>));
+    let mut sections = vec![
+        render_with(|w| man.render_title(w))?,
+        render_with(|w| man.render_name_section(w))?,
+        render_with(|w| man.render_synopsis_section(w))?,
+        render_with(|w| man.render_description_section(w))?,
+        render_with(|w| man.render_options_section(w))?,
+    ];
+    if page.has_subcommands() {
+        sections.push(render_with(|w| man.render_subcommands_section(w))?);
+    }
+    // The limits are a table: written without filling (`.nf`), where clap_mangen
+    // would run its lines together.
+    if let Some(limits) = limits {
+        let mut roff = String::from(".SH \"LIMITS AND EXIT CODES\"\n.nf\n");
+        for line in limits.lines() {
+            let line = line.replace('\\', "\\e").replace('-', "\\-");
+            let guard = if line.starts_with(['.', '\'']) {
+                "\\&"
+            } else {
+                ""
+            };
+            roff += &format!("{guard}{line}\n");
+        }
+        sections.push(roff + ".fi\n");
+    }
+    sections.push(render_with(|w| man.render_version_section(w))?);
+    // Each section rendered alone starts with the same two lines of set-up
+    // (`.ie`, `.el`): kept once, at the top.
+    let mut out = String::new();
+    for (k, section) in sections.iter().enumerate() {
+        for line in section.lines() {
+            if k == 0 || !(line.starts_with(".ie ") || line.starts_with(".el ")) {
+                out += line;
+                out.push('\n');
+            }
+        }
+    }
+    Ok(out.into_bytes())
+}
+
+/// What `render` writes, as text.
+fn render_with(
+    render: impl FnOnce(&mut Vec<u8>) -> std::io::Result<()>,
+) -> std::io::Result<String> {
+    let mut bytes = Vec::new();
+    render(&mut bytes)?;
+    Ok(String::from_utf8_lossy(&bytes).into_owned())
 }
 
 /// The contact sheet `raystep stages` writes: a row per stage, a column per buffer.
