@@ -159,6 +159,13 @@ fn check_describes_the_scene() {
     ] {
         assert!(stdout.contains(expected), "{expected:?} in\n{stdout}");
     }
+    // A true plane through the point of it nearest the origin, with no −0 in it.
+    let plane = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/true-plane.toml");
+    let stdout = text(&raystep(dir.path(), &["check", plane]).stdout);
+    assert!(
+        stdout.contains("    object 3: true plane through [0, -0.7, 0], normal [0, 1, 0]\n"),
+        "{stdout}"
+    );
 }
 
 #[test]
@@ -854,4 +861,70 @@ fn no_help_shows_rustdoc_syntax() {
     let help = text(&raystep(dir.path(), &["render", "--help"]).stdout);
     let from = format!("A BVH from {} spheres on", raystep::accel::BVH_FROM);
     assert!(help.contains(&from), "{help}");
+}
+
+#[test]
+fn float32_messages_name_the_scene_and_the_object_as_explain_numbers_it() {
+    // What --precision f32 refuses or warns about is named by its file, and by
+    // the object's number in explain, the studio and the object buffer.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let render = |scene: &str| {
+        let scene = root.join("scenes/stress").join(scene);
+        let args = ["render", scene.to_str().unwrap(), "--precision", "f32"];
+        let size = [
+            "--width",
+            "8",
+            "--height",
+            "6",
+            "-q",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        let run = raystep(dir.path(), &[&args[..], &size[..]].concat());
+        (
+            run.status.code(),
+            text(&run.stderr),
+            scene.display().to_string(),
+        )
+    };
+    let (code, said, scene) = render("seed-moved-1e5.toml");
+    assert_eq!(code, Some(2), "{said}");
+    assert!(
+        said.starts_with(&format!(
+            "error: {scene}: --precision f32: object 1, radius: 0.1 is smaller than 0.100001, "
+        )),
+        "{said}"
+    );
+    let (code, said, scene) = render("twins.toml");
+    assert_eq!(code, Some(0), "{said}");
+    assert!(
+        said.starts_with(&format!(
+            "warning: {scene}: --precision f32: object 1 (a sphere, center [0, 0, -3], \
+             radius 1.000000001) is object 0 in float32"
+        )),
+        "{said}"
+    );
+}
+
+#[test]
+fn chapter_one_shows_where_a_value_out_of_range_is() {
+    // The chapter's example: the seed with its second sphere's radius made -0.1,
+    // refused with the line and column of the value, as a syntax error is.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let chapter = std::fs::read_to_string(root.join("chapters/01-scene.md")).unwrap();
+    let command =
+        "$ raystep check scenes/seed.toml    # with the second sphere's radius made -0.1\n";
+    let start = chapter.find(command).expect("chapter 1 shows the example") + command.len();
+    let shown = &chapter[start..start + chapter[start..].find("```").unwrap()];
+    let seed = std::fs::read_to_string(root.join("scenes/seed.toml")).unwrap();
+    let changed = seed.replacen("\nradius = 0.1\n", "\nradius = -0.1\n", 1);
+    assert_ne!(changed, seed);
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("scenes")).unwrap();
+    std::fs::write(dir.path().join("scenes/seed.toml"), changed).unwrap();
+    let out = raystep(dir.path(), &["check", "scenes/seed.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(shown, text(&out.stderr));
 }

@@ -181,10 +181,98 @@ pub fn parse_sized(text: &str, file: &str, size: SizeOverride) -> Result<Scene, 
     };
     raw.check(size)
         .map_err(|message| match (size.width, size.height) {
-            (None, None) => fail(message),
-            _ if message.starts_with("--") => Error::Usage(message),
-            _ => fail(message),
+            _ if message.starts_with("--") && (size.width, size.height) != (None, None) => {
+                Error::Usage(message)
+            }
+            _ => fail(located(text, message)),
         })
+}
+
+/// A message of [`SceneFile::check`] with the line and column of the value it
+/// names first ("`[[sphere]] number 2, radius: …`", "`light.ambient: …`",
+/// "`screen: …`"), as a syntax error has them. Files of [`APART_FROM`] bytes or
+/// more are not read again for it (their message names the table and key alone),
+/// nor is a message that names no value of the file (a sphere of `[generate]`).
+fn located(text: &str, message: String) -> String {
+    if text.len() >= APART_FROM {
+        return message;
+    }
+    let Some(path) = named_value(&message) else {
+        return message;
+    };
+    let Ok(document) = toml::de::DeTable::parse(text) else {
+        return message;
+    };
+    let mut span = document.span();
+    let mut value = None::<&toml::de::DeValue>;
+    let mut table = Some(document.get_ref());
+    for step in &path {
+        let found = match (step, value, table) {
+            (Step::Key(key), _, Some(t)) => {
+                t.iter().find(|(k, _)| k.get_ref() == key).map(|(_, v)| v)
+            }
+            (Step::Entry(n), Some(toml::de::DeValue::Array(a)), _) => a.get(*n),
+            _ => None,
+        };
+        let Some(found) = found else {
+            break;
+        };
+        span = found.span();
+        value = Some(found.get_ref());
+        table = match found.get_ref() {
+            toml::de::DeValue::Table(t) => Some(t),
+            _ => None,
+        };
+    }
+    pointed(text, span, &message)
+}
+
+/// A step down a scene file's tables: a key, or the `n`-th entry (from 0) of an
+/// array of tables.
+enum Step {
+    Key(String),
+    Entry(usize),
+}
+
+/// The value a message of the loader names first, as steps from the file's top:
+/// `[[sphere]] number 2, radius` is `sphere`, entry 1, `radius`;
+/// `[[plane]] number 1, sphere, radius` goes one key deeper; `light.ambient` is
+/// two keys; `screen:` one.
+fn named_value(message: &str) -> Option<Vec<Step>> {
+    let word = |s: &str| -> usize {
+        s.find(|c: char| !(c.is_ascii_lowercase() || c == '_'))
+            .unwrap_or(s.len())
+    };
+    for table in ["sphere", "plane"] {
+        let Some(rest) = message.strip_prefix(&format!("[[{table}]] number ")) else {
+            continue;
+        };
+        let digits = rest
+            .find(|c: char| !c.is_ascii_digit())
+            .unwrap_or(rest.len());
+        let number: usize = rest[..digits].parse().ok()?;
+        let mut path = vec![Step::Key(table.into()), Step::Entry(number.checked_sub(1)?)];
+        let mut rest = &rest[digits..];
+        while let Some(next) = rest.strip_prefix(", ") {
+            let n = word(next);
+            if n == 0 {
+                break;
+            }
+            path.push(Step::Key(next[..n].into()));
+            rest = &next[n..];
+        }
+        return Some(path);
+    }
+    let n = word(message);
+    let table = &message[..n];
+    match message[n..].strip_prefix('.') {
+        Some(rest) if n > 0 && word(rest) > 0 => Some(vec![
+            Step::Key(table.into()),
+            Step::Key(rest[..word(rest)].into()),
+        ]),
+        None if n > 0 && message[n..].starts_with(':') => Some(vec![Step::Key(table.into())]),
+        _ => None,
+    }
 }
 
 /// Files from this many bytes on are read in parts ([`read_apart`]) where they
@@ -317,6 +405,15 @@ fn toml_error(e: &toml::de::Error, text: &str) -> String {
     let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
     let line_end = text[start..].find('\n').map_or(text.len(), |i| start + i);
     let what = brackets(&what, &text[line_start..line_end]).unwrap_or_else(|| with_hint(what));
+    pointed(text, start..span.end, &what)
+}
+
+/// `what`, said of the text at `span` of `text`: "line L, column C: what", the
+/// line (at most 80 characters of it) and a mark under the place.
+fn pointed(text: &str, span: std::ops::Range<usize>, what: &str) -> String {
+    let start = span.start.min(text.len());
+    let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
+    let line_end = text[start..].find('\n').map_or(text.len(), |i| start + i);
     let line = text[..start].matches('\n').count() + 1;
     let chars: Vec<char> = text[line_start..line_end]
         .trim_end_matches('\r')
@@ -862,10 +959,12 @@ impl PlaneKeys {
                 let normal = normal.normalize();
                 // Any point of the plane names it; keep the one nearest the origin,
                 // so that the numbers the plane is computed from are no larger than
-                // the plane's distance from the origin.
+                // the plane's distance from the origin. (Adding +0 turns the −0 of
+                // a zero component times a negative distance into 0, which every
+                // message and `raystep check` then show as 0, not −0.)
                 let anchor = point(p, &format!("{at}, point"))?;
                 Ok(Shape::Plane(Plane {
-                    point: normal * anchor.dot(normal),
+                    point: normal * anchor.dot(normal) + Vec3::ZERO,
                     normal,
                 }))
             }
@@ -1507,6 +1606,74 @@ mod tests {
             warnings[2 * TOLD + 1].starts_with("and 3 more spheres that float32 makes one"),
             "{}",
             warnings[2 * TOLD + 1]
+        );
+    }
+
+    #[test]
+    fn a_value_out_of_range_is_found_in_the_file() {
+        // The line and column of the value each kind of message names first.
+        let message = |text: &str| match parse(text, "f.toml") {
+            Err(Error::Scene { message, .. }) => message,
+            other => panic!("{other:?}"),
+        };
+        let sphere = "\n[[sphere]]\ncenter = [0, 0, -3]\nradius = 1\n";
+        let second = format!(
+            "{HEAD}{sphere}{}",
+            sphere.replace("radius = 1", "radius = -2")
+        );
+        let said = message(&second);
+        assert!(
+            said.starts_with("line 20, column 10: [[sphere]] number 2, radius: -2"),
+            "{said}"
+        );
+        assert!(
+            said.ends_with("\n20 | radius = -2\n   |          ^^"),
+            "{said}"
+        );
+        // A key inside an inline table of a [[plane]].
+        let said = message(&HEAD.replace("radius = 99", "radius = -99"));
+        assert!(
+            said.starts_with("line 12, column 44: [[plane]] number 1, sphere, radius"),
+            "{said}"
+        );
+        // A table's own key, and a table as a whole.
+        let said = message(&format!("{HEAD}{sphere}").replace("width = 64", "width = 0"));
+        assert!(
+            said.starts_with("line 2, column 9: image.width = 0"),
+            "{said}"
+        );
+        let screen = "\n[screen]\nleft = 1\nright = 1\n";
+        let said = message(&format!("{HEAD}{sphere}{screen}"));
+        assert!(
+            said.starts_with("line 18, column 1: screen: left (1)"),
+            "{said}"
+        );
+        // What the file does not hold is named without a place: a sphere of
+        // [generate] (the camera's position is the value the message names first).
+        let inside = format!("{HEAD}{sphere}").replace("center = [0, 0, -3]", "center = [0, 0, 1]");
+        let said = message(&inside);
+        assert!(
+            said.starts_with(
+                "line 6, column 12: camera.position [0, 0, 1] is inside [[sphere]] number 1"
+            ),
+            "{said}"
+        );
+        assert_eq!(
+            named_value("[generate] sphere number 3 (seed 1)").map(|p| p.len()),
+            None
+        );
+        // A file of a mebibyte or more is not read again to find the place.
+        let big = format!(
+            "{}{sphere}",
+            HEAD.replace(
+                "\n[camera]",
+                &format!("\n{}\n[camera]", "#".repeat(APART_FROM))
+            )
+        );
+        let said = message(&big.replace("radius = 1", "radius = -2"));
+        assert!(
+            said.starts_with("[[sphere]] number 1, radius: -2"),
+            "{said}"
         );
     }
 }

@@ -479,8 +479,9 @@ impl StagesArgs {
 }
 
 impl RuleArgs {
-    /// The settings for `stages` under these rules; a `--max-depth` goes into `scene`.
-    pub fn apply(&self, scene: &mut Scene, stages: Stages) -> Result<Settings, Error> {
+    /// The settings for `stages` under these rules; a `--max-depth` goes into
+    /// `scene`, whose messages name it `name`.
+    pub fn apply(&self, scene: &mut Scene, name: &str, stages: Stages) -> Result<Settings, Error> {
         if let Some(depth) = self.max_depth {
             check_max_depth(depth, "--max-depth").map_err(Error::Usage)?;
             scene.max_depth = depth;
@@ -495,9 +496,9 @@ impl RuleArgs {
         }
         let precision = self.precision.unwrap_or(base.precision);
         let warnings = crate::io::scene_file::check_precision(scene, precision)
-            .map_err(|e| Error::Usage(format!("--precision {precision}: {e}")))?;
+            .map_err(|e| Error::Usage(format!("{name}: --precision {precision}: {e}")))?;
         for warning in warnings {
-            eprintln!("warning: --precision {precision}: {warning}");
+            eprintln!("warning: {name}: --precision {precision}: {warning}");
         }
         Ok(Settings {
             stages,
@@ -517,8 +518,8 @@ impl RuleArgs {
 /// The scene and settings a `render` (or `bench`) command line asks for.
 pub fn prepare(args: &FrameArgs) -> Result<(Scene, Settings), Error> {
     let stages = Stages::select(args.stage, &args.without).map_err(Error::Usage)?;
-    let (mut scene, _) = load_scene(&args.scene)?;
-    let settings = args.rules.apply(&mut scene, stages)?;
+    let (mut scene, name) = load_scene(&args.scene)?;
+    let settings = args.rules.apply(&mut scene, &name, stages)?;
     Ok((scene, settings))
 }
 

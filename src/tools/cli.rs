@@ -250,7 +250,7 @@ pub const CONTACT_SHEET: &str = "contact-sheet.png";
 
 fn stages(args: StagesArgs) -> Result<(), Error> {
     let (mut scene, name) = load_scene(&args.scene)?;
-    let base = args.rules.apply(&mut scene, Stages::ALL)?;
+    let base = args.rules.apply(&mut scene, &name, Stages::ALL)?;
     // Every file of every stage is renamed into place at the end, together: an
     // error or Ctrl-C on the way leaves the folder as it was.
     let mut pending = Pending::new()

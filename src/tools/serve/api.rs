@@ -409,7 +409,7 @@ impl Studio {
             height: frame.scene.height,
         };
         let (mut scene, version) = self.scene_at(size, edits)?;
-        let settings = frame.rules.apply(&mut scene, stages)?;
+        let settings = frame.rules.apply(&mut scene, &self.name, stages)?;
         Ok((scene, settings, version))
     }
 
