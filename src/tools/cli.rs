@@ -590,7 +590,11 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 /// message ("rendering", "writing files"); ticking on its own, so that a long
 /// write does not look stalled.
 fn job_bar(len: u64, unit: &str) -> ProgressBar {
-    let bar = counted_bar(len, "{msg:<24}", unit);
+    // As wide as the longest phase, "writing files 02-intersection", so that the
+    // bar stays where it is from phase to phase.
+    let widest = Stage::ALL.iter().map(|s| s.folder().len()).max().unwrap_or(0);
+    let label = format!("{{msg:<{}}}", "writing files ".len() + widest);
+    let bar = counted_bar(len, &label, unit);
     bar.enable_steady_tick(std::time::Duration::from_millis(250));
     bar
 }
