@@ -173,13 +173,7 @@ fn chapter_one_shows_what_check_prints() {
     // The chapter's transcript of `raystep check scenes/seed.toml`, run from the
     // repository's root, is the command's output as it is now.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let chapter = std::fs::read_to_string(root.join("chapters/01-scene.md")).unwrap();
-    let command = "$ raystep check scenes/seed.toml\n";
-    let start = chapter
-        .find(command)
-        .expect("chapter 1 shows raystep check")
-        + command.len();
-    let shown = &chapter[start..start + chapter[start..].find("```").unwrap()];
+    let shown = common::transcript("01-scene.md", "raystep check scenes/seed.toml");
     let out = raystep(root, &["check", "scenes/seed.toml"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert_eq!(shown, text(&out.stdout));
@@ -913,11 +907,10 @@ fn chapter_one_shows_where_a_value_out_of_range_is() {
     // The chapter's example: the seed with its second sphere's radius made -0.1,
     // refused with the line and column of the value, as a syntax error is.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let chapter = std::fs::read_to_string(root.join("chapters/01-scene.md")).unwrap();
-    let command =
-        "$ raystep check scenes/seed.toml    # with the second sphere's radius made -0.1\n";
-    let start = chapter.find(command).expect("chapter 1 shows the example") + command.len();
-    let shown = &chapter[start..start + chapter[start..].find("```").unwrap()];
+    let shown = common::transcript(
+        "01-scene.md",
+        "raystep check scenes/seed.toml    # with the second sphere's radius made -0.1",
+    );
     let seed = std::fs::read_to_string(root.join("scenes/seed.toml")).unwrap();
     let changed = seed.replacen("\nradius = 0.1\n", "\nradius = -0.1\n", 1);
     assert_ne!(changed, seed);

@@ -586,13 +586,10 @@ fn help_states_every_limit_with_the_numbers_the_code_uses() {
 #[test]
 fn chapter_1_quotes_the_message_raystep_gives() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let chapter = std::fs::read_to_string(root.join("chapters/01-scene.md")).unwrap();
-    let command = "$ raystep check tests/hostile/scenes/unknown-radus.toml\n";
-    let quoted = chapter
-        .split(command)
-        .nth(1)
-        .expect("the chapter runs the command");
-    let quoted = &quoted[..quoted.find("```").unwrap()];
+    let quoted = common::transcript(
+        "01-scene.md",
+        "raystep check tests/hostile/scenes/unknown-radus.toml",
+    );
     let out = raystep(root, &["check", "tests/hostile/scenes/unknown-radus.toml"]);
     assert_eq!(quoted, String::from_utf8_lossy(&out.stderr));
 }

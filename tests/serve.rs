@@ -377,9 +377,24 @@ fn the_scene_is_json_with_a_version_and_the_page_is_served() {
     assert_eq!(scene["file"], "scenes/seed.toml (built in)");
     assert_eq!(scene["scene"]["width"], 300);
     assert_eq!(scene["scene"]["objects"].as_array().unwrap().len(), 4);
-    assert_eq!(scene["scene"]["objects"][0]["shape"]["radius"], 0.7);
+    assert_eq!(scene["scene"]["objects"][0]["radius"], 0.7);
     assert_eq!(scene["scene"]["object_count"], 4);
     assert_eq!(server.get("/api/scene?objects=all").json(), scene);
+    // The scene as `raystep check --json` gives it, field for field, but for its
+    // name (the file's) and the schema.
+    let seed = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/seed.toml");
+    let check = Command::new(env!("CARGO_BIN_EXE_raystep"))
+        .args(["check", seed, "--json"])
+        .output()
+        .unwrap();
+    let mut checked: Value = serde_json::from_slice(&check.stdout).unwrap();
+    let mut served = scene["scene"].clone();
+    for fields in [&mut checked, &mut served] {
+        let fields = fields.as_object_mut().unwrap();
+        fields.remove("scene");
+        fields.remove("schema");
+    }
+    assert_eq!(served, checked);
     // What the page asks for: all but the list of objects.
     let brief = server.get("/api/scene?objects=none").json();
     assert_eq!(brief["scene"].get("objects"), None, "{brief}");
@@ -1023,7 +1038,7 @@ fn saving_the_scene_reloads_it_with_an_event_and_a_broken_file_keeps_the_last_go
     );
     let json = server.get("/api/scene").json();
     assert_eq!(json["version"], 2);
-    assert_eq!(json["scene"]["objects"][0]["shape"]["radius"], 0.5);
+    assert_eq!(json["scene"]["objects"][0]["radius"], 0.5);
     let after = server.get("/api/render?width=60&height=40");
     assert_eq!(after.header("X-Raystep-Scene-Version"), Some("2"));
     assert_ne!(after.body, before, "the picture follows the file");
@@ -1047,7 +1062,7 @@ fn saving_the_scene_reloads_it_with_an_event_and_a_broken_file_keeps_the_last_go
     let json = server.get("/api/scene").json();
     assert_eq!(json["version"], 3);
     assert_eq!(json["error"], cli.as_str());
-    assert_eq!(json["scene"]["objects"][0]["shape"]["radius"], 0.5);
+    assert_eq!(json["scene"]["objects"][0]["radius"], 0.5);
     assert_eq!(
         server.get("/api/render?width=60&height=40").body,
         after.body

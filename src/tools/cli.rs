@@ -19,7 +19,7 @@ use crate::tools::args::{
     ChartArgs, CheckArgs, Cli, Command, DiffArgs, ExplainArgs, FiguresArgs, Generated, RenderArgs,
     StagesArgs,
 };
-use crate::tools::json::json_text;
+use crate::tools::json::{json_text, scene_json};
 
 /// Print a line on stdout, returning from the function with an error if it
 /// cannot be written ([`say_line`]).
@@ -592,7 +592,11 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 fn job_bar(len: u64, unit: &str) -> ProgressBar {
     // As wide as the longest phase, "writing files 02-intersection", so that the
     // bar stays where it is from phase to phase.
-    let widest = Stage::ALL.iter().map(|s| s.folder().len()).max().unwrap_or(0);
+    let widest = Stage::ALL
+        .iter()
+        .map(|s| s.folder().len())
+        .max()
+        .unwrap_or(0);
     let label = format!("{{msg:<{}}}", "writing files ".len() + widest);
     let bar = counted_bar(len, &label, unit);
     bar.enable_steady_tick(std::time::Duration::from_millis(250));
@@ -807,77 +811,11 @@ fn check(args: &CheckArgs) -> Result<(), Error> {
     let scene = scene_file::load(path)?;
     warn_if_empty(&scene, &name);
     if args.json {
-        return say_json(describe_json(&scene, &name), true);
+        return say_json(scene_json(&scene, &name, true), true);
     }
     let listed = (!args.all).then_some(LISTED);
     say!("{}", describe(&scene, &name, listed).trim_end());
     Ok(())
-}
-
-/// A checked scene as `raystep check --json` prints it (without `"schema"`).
-pub fn describe_json(scene: &Scene, name: &str) -> serde_json::Value {
-    use serde_json::json;
-    let v = |v: crate::Vec3| json!([v.x, v.y, v.z]);
-    let s = scene.camera().screen;
-    let objects: Vec<serde_json::Value> = scene
-        .objects
-        .iter()
-        .map(|o| {
-            let m = &o.material;
-            let material = json!({
-                "ambient": v(m.ambient),
-                "diffuse": v(m.diffuse),
-                "specular": v(m.specular),
-                "shininess": m.shininess,
-                "reflection": m.reflection,
-            });
-            let entry = match o.role {
-                Role::Sphere => "sphere",
-                Role::Floor => "plane",
-            };
-            match o.shape {
-                Shape::Sphere(sp) => json!({
-                    "entry": entry,
-                    "shape": "sphere",
-                    "center": v(sp.center),
-                    "radius": sp.radius,
-                    "material": material,
-                }),
-                Shape::Plane(p) => json!({
-                    "entry": entry,
-                    "shape": "plane",
-                    "point": v(p.point),
-                    "normal": v(p.normal),
-                    "material": material,
-                }),
-            }
-        })
-        .collect();
-    let l = &scene.light;
-    json!({
-        "scene": name,
-        "valid": true,
-        "width": scene.width,
-        "height": scene.height,
-        "max_depth": scene.max_depth,
-        "camera": v(scene.camera),
-        "screen": {
-            "left": s.left,
-            "right": s.right,
-            "top": s.top,
-            "bottom": s.bottom,
-            "from_scene": scene.screen.is_some(),
-        },
-        "light": {
-            "position": v(l.position),
-            "ambient": v(l.ambient),
-            "diffuse": v(l.diffuse),
-            "specular": v(l.specular),
-        },
-        "spheres": scene.objects.iter().filter(|o| o.role == Role::Sphere).count(),
-        "planes": scene.objects.iter().filter(|o| o.role == Role::Floor).count(),
-        "objects": objects,
-    })
 }
 
 /// How many spheres (and planes) `raystep check` lists in words before it counts

@@ -1,6 +1,8 @@
 //! The JSON the commands print (`--json`; `accuracy --json`, an array of them)
 //! and the studio's `/api/pixel` and `/api/diff` answer: one object with a
-//! `"schema"` version.
+//! `"schema"` version; and the scene as `check --json` and `/api/scene` give it.
+
+use crate::scene::{Role, Scene, Shape};
 
 /// The version of every JSON object raystep prints (`"schema": 1`): it grows when
 /// a field changes meaning or goes away, not when a field is added.
@@ -24,4 +26,76 @@ pub fn json_text(value: &impl serde::Serialize, pretty: bool) -> String {
         serde_json::to_string(&object)
     }
     .expect("plain data serialises")
+}
+
+/// A scene as `raystep check --json` prints it and the studio's `/api/scene`
+/// answers it (without `"schema"`): what `raystep check` describes, as numbers,
+/// `object_count`, and the list of `objects` only if `listed`.
+pub fn scene_json(scene: &Scene, name: &str, listed: bool) -> serde_json::Value {
+    use serde_json::json;
+    let v = |v: crate::Vec3| json!([v.x, v.y, v.z]);
+    let s = scene.camera().screen;
+    let objects = |scene: &Scene| -> Vec<serde_json::Value> {
+        (scene.objects.iter())
+            .map(|o| {
+                let m = &o.material;
+                let material = json!({
+                    "ambient": v(m.ambient),
+                    "diffuse": v(m.diffuse),
+                    "specular": v(m.specular),
+                    "shininess": m.shininess,
+                    "reflection": m.reflection,
+                });
+                let entry = match o.role {
+                    Role::Sphere => "sphere",
+                    Role::Floor => "plane",
+                };
+                match o.shape {
+                    Shape::Sphere(sp) => json!({
+                        "entry": entry,
+                        "shape": "sphere",
+                        "center": v(sp.center),
+                        "radius": sp.radius,
+                        "material": material,
+                    }),
+                    Shape::Plane(p) => json!({
+                        "entry": entry,
+                        "shape": "plane",
+                        "point": v(p.point),
+                        "normal": v(p.normal),
+                        "material": material,
+                    }),
+                }
+            })
+            .collect()
+    };
+    let l = &scene.light;
+    let mut described = json!({
+        "scene": name,
+        "valid": true,
+        "width": scene.width,
+        "height": scene.height,
+        "max_depth": scene.max_depth,
+        "camera": v(scene.camera),
+        "screen": {
+            "left": s.left,
+            "right": s.right,
+            "top": s.top,
+            "bottom": s.bottom,
+            "from_scene": scene.screen.is_some(),
+        },
+        "light": {
+            "position": v(l.position),
+            "ambient": v(l.ambient),
+            "diffuse": v(l.diffuse),
+            "specular": v(l.specular),
+        },
+        "spheres": scene.objects.iter().filter(|o| o.role == Role::Sphere).count(),
+        "planes": scene.objects.iter().filter(|o| o.role == Role::Floor).count(),
+        "object_count": scene.objects.len(),
+    });
+    if listed {
+        described["objects"] = serde_json::Value::Array(objects(scene));
+    }
+    described
 }

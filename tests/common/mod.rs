@@ -86,6 +86,19 @@ pub fn raystep(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
         .expect("the binary runs")
 }
 
+/// What chapter `file` (in `chapters/`) shows after the line `$ COMMAND`, up to
+/// the end of its code block: the transcript a test holds to the command.
+pub fn transcript(file: &str, command: &str) -> String {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let chapter = std::fs::read_to_string(root.join("chapters").join(file)).unwrap();
+    let line = format!("$ {command}\n");
+    let after = chapter
+        .split(&line)
+        .nth(1)
+        .unwrap_or_else(|| panic!("{file} shows `{line}`"));
+    after[..after.find("```").unwrap()].to_string()
+}
+
 /// `n` with a comma between each group of three digits, as the book and the
 /// help write counts.
 pub fn grouped(n: usize) -> String {

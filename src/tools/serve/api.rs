@@ -23,7 +23,7 @@ use crate::error::Error;
 use crate::io::output::PngEncoding;
 use crate::io::scene_file::{self, SizeOverride};
 use crate::render::Settings;
-use crate::scene::{Role, Scene, Shape};
+use crate::scene::Scene;
 use crate::stages::Stages;
 use crate::tools::args::{check_pixel, Cli, Command, FrameArgs};
 
@@ -556,7 +556,7 @@ impl Studio {
             "version": served.version,
             "file": self.name,
             "error": served.error,
-            "scene": describe_scene(&served.scene, listed),
+            "scene": crate::tools::json::scene_json(&served.scene, &self.name, listed),
         }))
     }
 }
@@ -811,62 +811,4 @@ pub struct Rendered {
     pub render_seconds: f64,
     /// How long the PNG took to encode.
     pub encode_seconds: f64,
-}
-
-/// The scene as JSON: everything `raystep check` describes, as numbers, and
-/// the number of objects; their list only if `listed`.
-pub fn describe_scene(scene: &Scene, listed: bool) -> Value {
-    let camera = scene.camera();
-    let s = camera.screen;
-    let l = &scene.light;
-    let mut described = json!({
-        "width": scene.width,
-        "height": scene.height,
-        "camera": scene.camera.to_array(),
-        "screen": {
-            "left": s.left, "right": s.right, "top": s.top, "bottom": s.bottom,
-            "set_by_scene": scene.screen.is_some(),
-        },
-        "light": {
-            "position": l.position.to_array(),
-            "ambient": l.ambient.to_array(),
-            "diffuse": l.diffuse.to_array(),
-            "specular": l.specular.to_array(),
-        },
-        "max_depth": scene.max_depth,
-        "object_count": scene.objects.len(),
-    });
-    if !listed {
-        return described;
-    }
-    let objects: Vec<Value> = scene
-        .objects
-        .iter()
-        .enumerate()
-        .map(|(index, o)| {
-            let m = &o.material;
-            let material = json!({
-                "ambient": m.ambient.to_array(),
-                "diffuse": m.diffuse.to_array(),
-                "specular": m.specular.to_array(),
-                "shininess": m.shininess,
-                "reflection": m.reflection,
-            });
-            let section = match o.role {
-                Role::Sphere => "sphere",
-                Role::Floor => "plane",
-            };
-            let shape = match o.shape {
-                Shape::Sphere(sp) => json!({
-                    "kind": "sphere", "center": sp.center.to_array(), "radius": sp.radius,
-                }),
-                Shape::Plane(p) => json!({
-                    "kind": "plane", "point": p.point.to_array(), "normal": p.normal.to_array(),
-                }),
-            };
-            json!({ "index": index, "section": section, "shape": shape, "material": material })
-        })
-        .collect();
-    described["objects"] = Value::Array(objects);
-    described
 }
