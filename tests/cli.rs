@@ -759,8 +759,29 @@ fn completions_and_a_man_page() {
         .lines()
         .filter_map(|l| l.strip_prefix("raystep\\-")?.strip_suffix("(1)"))
         .collect();
+    let mut listed: Vec<String> = listed.into_iter().map(String::from).collect();
+    // And every page those pages refer to (generate's: generate-spheres).
+    let mut k = 0;
+    while k < listed.len() {
+        let command = listed[k].clone();
+        let page = text(&raystep(dir.path(), &["man", &command]).stdout);
+        for line in page.lines() {
+            let Some(name) = line
+                .strip_prefix("raystep\\-")
+                .and_then(|l| l.strip_suffix("(1)"))
+            else {
+                continue;
+            };
+            let name = name.replace("\\-", "-");
+            if !listed.contains(&name) {
+                listed.push(name);
+            }
+        }
+        k += 1;
+    }
     assert_eq!(listed, raystep::tools::args::COMMANDS, "{page}");
-    for command in listed {
+    for command in &listed {
+        let command = command.as_str();
         let man = raystep(dir.path(), &["man", command]);
         assert!(man.status.success(), "{command}: {}", text(&man.stderr));
         let page = text(&man.stdout);
@@ -768,10 +789,8 @@ fn completions_and_a_man_page() {
             page.contains(&format!(".TH raystep-{command} 1 ")),
             "{command}: {page}"
         );
-        assert!(
-            page.contains(&format!("\\fBraystep {command}\\fR")),
-            "{page}"
-        );
+        let words = command.replace('-', " ");
+        assert!(page.contains(&format!("\\fBraystep {words}\\fR")), "{page}");
     }
     assert_eq!(
         raystep(dir.path(), &["man", "nothing"]).status.code(),
@@ -920,4 +939,55 @@ fn chapter_one_shows_where_a_value_out_of_range_is() {
     let out = raystep(dir.path(), &["check", "scenes/seed.toml"]);
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(shown, text(&out.stderr));
+}
+
+#[test]
+fn status_lines_and_refusals_say_what_they_mean() {
+    let dir = tempfile::tempdir().unwrap();
+    // A folder given with a slash is named with one.
+    let out = raystep(
+        dir.path(),
+        &["render", "--width", "8", "--height", "6", "-o", "r1/"],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let said = text(&out.stderr);
+    assert!(
+        said.contains("\n  r1/ ") && !said.contains("r1//"),
+        "{said}"
+    );
+    // bench keeps its status line on standard error with --json, and a ratio
+    // below 1 reads as one ("0.5× as fast", not "0.5× faster").
+    let out = raystep(
+        dir.path(),
+        &[
+            "bench", "--width", "8", "--height", "6", "--runs", "1", "--json",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).starts_with("scenes/seed.toml (built in): rays+"),
+        "{}",
+        text(&out.stderr)
+    );
+    serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap();
+    let words = text(
+        &raystep(
+            dir.path(),
+            &["bench", "--width", "8", "--height", "6", "--runs", "1"],
+        )
+        .stdout,
+    );
+    assert!(
+        words.contains("threads are ") && words.contains("× as fast"),
+        "{words}"
+    );
+    assert!(!words.contains("faster"), "{words}");
+    // An option that means something only with another is refused without it.
+    let out = raystep(dir.path(), &["chart", "--max-count", "10"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("--scale"),
+        "{}",
+        text(&out.stderr)
+    );
 }

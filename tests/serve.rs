@@ -628,6 +628,16 @@ fn the_light_and_the_camera_moved_render_and_save_as_the_scene_file_does() {
         assert!(!reply.error().is_empty());
     }
     assert_eq!(server.get("/api/render?light=1,2").status, 400);
+    // A light moved into a sphere: the message names the light and the sphere,
+    // but no line of the file, whose text the move is not.
+    let inside = server.get("/api/render?light=-0.2,0,-1");
+    assert_eq!(inside.status, 400);
+    let said = inside.error();
+    assert!(
+        said.contains("light.position [-0.2, 0, -1] is inside [[sphere]] number 1"),
+        "{said}"
+    );
+    assert!(!said.contains("line "), "{said}");
 }
 
 /// Two renders at once each have threads of their own: a small render of one

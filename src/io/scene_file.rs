@@ -151,6 +151,18 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, Error> {
 /// Check the TOML text of a scene at the size `size` asks for (the size decides the
 /// default screen, so it is settled before anything is checked).
 pub fn parse_sized(text: &str, file: &str, size: SizeOverride) -> Result<Scene, Error> {
+    parse_text(text, file, size, true)
+}
+
+/// [`parse_sized`] for a text made from the file, not the file's own (the studio's
+/// moved light or camera): a value out of range is named by table and key alone,
+/// since a line and column of that text would point at nothing in the file.
+pub fn parse_edited(text: &str, file: &str, size: SizeOverride) -> Result<Scene, Error> {
+    parse_text(text, file, size, false)
+}
+
+/// [`parse_sized`], and whether a value out of range gets its place ([`located`]).
+fn parse_text(text: &str, file: &str, size: SizeOverride, locate: bool) -> Result<Scene, Error> {
     let fail = |message: String| Error::Scene {
         file: file.to_string(),
         message,
@@ -184,7 +196,8 @@ pub fn parse_sized(text: &str, file: &str, size: SizeOverride) -> Result<Scene, 
             _ if message.starts_with("--") && (size.width, size.height) != (None, None) => {
                 Error::Usage(message)
             }
-            _ => fail(located(text, message)),
+            _ if locate => fail(located(text, message)),
+            _ => fail(message),
         })
 }
 
@@ -203,7 +216,7 @@ fn located(text: &str, message: String) -> String {
     let Ok(document) = toml::de::DeTable::parse(text) else {
         return message;
     };
-    let mut span = document.span();
+    let mut span = None;
     let mut value = None::<&toml::de::DeValue>;
     let mut table = Some(document.get_ref());
     for step in &path {
@@ -217,14 +230,18 @@ fn located(text: &str, message: String) -> String {
         let Some(found) = found else {
             break;
         };
-        span = found.span();
+        span = Some(found.span());
         value = Some(found.get_ref());
         table = match found.get_ref() {
             toml::de::DeValue::Table(t) => Some(t),
             _ => None,
         };
     }
-    pointed(text, span, &message)
+    match span {
+        Some(span) => pointed(text, span, &message),
+        // Not even the first step is in the file (a key made by a default).
+        None => message,
+    }
 }
 
 /// A step down a scene file's tables: a key, or the `n`-th entry (from 0) of an
@@ -253,6 +270,12 @@ fn named_value(message: &str) -> Option<Vec<Step>> {
         let number: usize = rest[..digits].parse().ok()?;
         let mut path = vec![Step::Key(table.into()), Step::Entry(number.checked_sub(1)?)];
         let mut rest = &rest[digits..];
+        // A fake plane's own checks call it "[[plane]] number N (a sphere)": the
+        // numbers are in its `sphere = {…}`.
+        if let Some(after) = rest.strip_prefix(" (a sphere)") {
+            path.push(Step::Key("sphere".into()));
+            rest = after;
+        }
         while let Some(next) = rest.strip_prefix(", ") {
             let n = word(next);
             if n == 0 {
@@ -826,8 +849,8 @@ impl SceneFile {
                  least {MIN_RADIUS:e}), or rays to the screen have no direction; e.g. \
                  position = [0, 0, 1]",
                 shown(camera.z),
-                shown(nearest),
-                ratio_shown(MIN_RADIUS_RATIO_F64),
+                six_digits(nearest),
+                six_digits(MIN_RADIUS_RATIO_F64),
                 shown(size)
             ));
         }
@@ -1337,15 +1360,18 @@ fn describe(object: &Object) -> String {
     }
 }
 
-/// A limit's ratio as messages show it: `1e-6`, `1.9e-15`.
-fn ratio_shown(ratio: f64) -> String {
-    format!("{ratio:.1e}").replace(".0e", "e")
-}
-
-/// A computed limit to six significant digits (`1.86265e-12`, `0.100001`), not
-/// the seventeen that make it exact (`0.10000099999999999`).
+/// A computed least value to six significant digits (`1.86266e-12`,
+/// `0.100001`), not the seventeen that make it exact (`0.10000099999999999`):
+/// rounded up, so that the number shown is itself accepted.
 fn six_digits(v: f64) -> String {
-    let rounded: f64 = format!("{v:.5e}").parse().unwrap_or(v);
+    let nearest = format!("{v:.5e}");
+    let mut rounded: f64 = nearest.parse().unwrap_or(v);
+    if rounded < v {
+        // One step up in the sixth digit.
+        let (digits, exponent) = nearest.split_once('e').unwrap_or((&nearest, "0"));
+        let up = digits.parse::<f64>().unwrap_or(0.0) + 1e-5;
+        rounded = format!("{up:.5}e{exponent}").parse().unwrap_or(v);
+    }
     shown(rounded)
 }
 
@@ -1662,6 +1688,15 @@ mod tests {
             named_value("[generate] sphere number 3 (seed 1)").map(|p| p.len()),
             None
         );
+        // A fake plane's own checks name its sphere "(a sphere)": the key is in it.
+        let path = named_value("[[plane]] number 2 (a sphere), radius: 1e-300 is smaller");
+        let keys: Vec<String> = (path.unwrap().iter())
+            .map(|step| match step {
+                Step::Key(k) => k.clone(),
+                Step::Entry(n) => n.to_string(),
+            })
+            .collect();
+        assert_eq!(keys, ["plane", "1", "sphere", "radius"]);
         // A file of a mebibyte or more is not read again to find the place.
         let big = format!(
             "{}{sphere}",
@@ -1675,5 +1710,22 @@ mod tests {
             said.starts_with("[[sphere]] number 1, radius: -2"),
             "{said}"
         );
+    }
+
+    #[test]
+    fn a_least_value_is_shown_rounded_up_to_six_digits() {
+        assert_eq!(six_digits(0.100001), "0.100001");
+        assert_eq!(six_digits(0.10000099999999999), "0.100001");
+        // Rounded to nearest, 0.1234564 would show as 0.123456, a radius that
+        // the same message would refuse.
+        assert_eq!(six_digits(0.1234564), "0.123457");
+        for k in 1..2000 {
+            let v = f64::from(k).sqrt() * 1.2345e-7 * f64::from(k);
+            let shown: f64 = six_digits(v).parse().unwrap();
+            assert!(
+                shown >= v && shown <= v * (1.0 + 2e-5),
+                "{v} shown as {shown}"
+            );
+        }
     }
 }

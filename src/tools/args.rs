@@ -106,8 +106,9 @@ pub enum Command {
     },
 }
 
-/// The commands that have a manual page of their own (`raystep man COMMAND`).
-pub const COMMANDS: [&str; 13] = [
+/// The commands that have a manual page of their own (`raystep man COMMAND`;
+/// `generate-spheres` is `raystep generate spheres`).
+pub const COMMANDS: [&str; 14] = [
     "stages",
     "render",
     "explain",
@@ -121,6 +122,7 @@ pub const COMMANDS: [&str; 13] = [
     "serve",
     "completions",
     "man",
+    "generate-spheres",
 ];
 
 /// Arguments of `raystep explain`.

@@ -185,9 +185,9 @@ fn man_page(command: Option<&str>) -> std::io::Result<Vec<u8>> {
     cli.build();
     let page = match command {
         None => cli,
-        Some(name) => cli
-            .find_subcommand(name)
-            .cloned()
+        // `generate-spheres`: `spheres` under `generate`.
+        Some(name) => (name.split('-'))
+            .try_fold(cli, |command, word| command.find_subcommand(word).cloned())
             .expect("COMMANDS names raystep's commands")
             // (clap keeps a name for as long as the program runs, and this one
             // ends once the page is printed.)

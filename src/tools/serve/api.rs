@@ -376,7 +376,7 @@ impl Studio {
                 (Arc::clone(&served.text), served.version)
             };
             let text = edits.apply(&text, &self.name)?;
-            return Ok((scene_file::parse_sized(&text, &self.name, size)?, version));
+            return Ok((scene_file::parse_edited(&text, &self.name, size)?, version));
         }
         let (text, version) = {
             let served = self.lock();
