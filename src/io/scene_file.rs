@@ -890,7 +890,14 @@ impl SceneFile {
             let seed = keys.seed.unwrap_or(1);
             for (i, object) in generated_objects(count, seed).enumerate() {
                 if let Shape::Sphere(shape) = &object.shape {
-                    let at = Lazy(|| format!("[generate] sphere number {} (seed {seed})", i + 1));
+                    // Not in the file: named by the number explain and check give it too.
+                    let id = objects.len();
+                    let at = Lazy(|| {
+                        format!(
+                            "[generate] sphere number {} (object {id}, seed {seed})",
+                            i + 1
+                        )
+                    });
                     placed(shape, &at, camera, light.position, MIN_RADIUS_RATIO_F64)?;
                 }
                 objects.push(object);
@@ -1685,7 +1692,7 @@ mod tests {
             "{said}"
         );
         assert_eq!(
-            named_value("[generate] sphere number 3 (seed 1)").map(|p| p.len()),
+            named_value("[generate] sphere number 3 (object 2, seed 1)").map(|p| p.len()),
             None
         );
         // A fake plane's own checks name its sphere "(a sphere)": the key is in it.
