@@ -19,8 +19,12 @@ fn main() -> ExitCode {
             let printed = e.print().and_then(|()| std::io::stdout().flush());
             return match printed {
                 Err(io) if io.kind() != std::io::ErrorKind::BrokenPipe => {
-                    eprintln!("error: cannot write standard output: {io}");
-                    ExitCode::from(2)
+                    let error = raystep::error::Error::Output {
+                        path: "standard output".into(),
+                        message: io.to_string(),
+                    };
+                    eprintln!("error: {error}");
+                    ExitCode::from(error.exit_code())
                 }
                 _ => ExitCode::from(e.exit_code() as u8),
             };

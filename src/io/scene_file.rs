@@ -191,14 +191,12 @@ fn parse_text(text: &str, file: &str, size: SizeOverride, locate: bool) -> Resul
         Some(raw) => raw,
         None => toml::from_str::<SceneFile>(text).map_err(|e| fail(toml_error(&e, text)))?,
     };
-    raw.check(size)
-        .map_err(|message| match (size.width, size.height) {
-            _ if message.starts_with("--") && (size.width, size.height) != (None, None) => {
-                Error::Usage(message)
-            }
-            _ if locate => fail(located(text, message)),
-            _ => fail(message),
-        })
+    let overridden = size.width.is_some() || size.height.is_some();
+    raw.check(size).map_err(|message| match () {
+        _ if overridden && message.starts_with("--") => Error::Usage(message),
+        _ if locate => fail(located(text, message)),
+        _ => fail(message),
+    })
 }
 
 /// A message of [`SceneFile::check`] with the line and column of the value it
@@ -207,6 +205,7 @@ fn parse_text(text: &str, file: &str, size: SizeOverride, locate: bool) -> Resul
 /// more are not read again for it (their message names the table and key alone),
 /// nor is a message that names no value of the file (a sphere of `[generate]`).
 fn located(text: &str, message: String) -> String {
+    use toml::de::DeValue;
     if text.len() >= APART_FROM {
         return message;
     }
@@ -216,26 +215,25 @@ fn located(text: &str, message: String) -> String {
     let Ok(document) = toml::de::DeTable::parse(text) else {
         return message;
     };
-    let mut span = None;
-    let mut value = None::<&toml::de::DeValue>;
-    let mut table = Some(document.get_ref());
+    fn key_of<'t, 'i>(
+        table: &'t toml::de::DeTable<'i>,
+        key: &str,
+    ) -> Option<&'t toml::Spanned<DeValue<'i>>> {
+        (table.iter().find(|(k, _)| k.get_ref() == key)).map(|(_, v)| v)
+    }
+    // The value reached so far (`None`: the document's top), and its place.
+    let (mut here, mut span) = (None::<&DeValue>, None);
     for step in &path {
-        let found = match (step, value, table) {
-            (Step::Key(key), _, Some(t)) => {
-                t.iter().find(|(k, _)| k.get_ref() == key).map(|(_, v)| v)
-            }
-            (Step::Entry(n), Some(toml::de::DeValue::Array(a)), _) => a.get(*n),
+        let found = match (step, here) {
+            (Step::Key(key), None) => key_of(document.get_ref(), key),
+            (Step::Key(key), Some(DeValue::Table(t))) => key_of(t, key),
+            (Step::Entry(n), Some(DeValue::Array(a))) => a.get(*n),
             _ => None,
         };
         let Some(found) = found else {
             break;
         };
-        span = Some(found.span());
-        value = Some(found.get_ref());
-        table = match found.get_ref() {
-            toml::de::DeValue::Table(t) => Some(t),
-            _ => None,
-        };
+        (here, span) = (Some(found.get_ref()), Some(found.span()));
     }
     match span {
         Some(span) => pointed(text, span, &message),

@@ -35,39 +35,35 @@ pub fn scene_json(scene: &Scene, name: &str, listed: bool) -> serde_json::Value 
     use serde_json::json;
     let v = |v: crate::Vec3| json!([v.x, v.y, v.z]);
     let s = scene.camera().screen;
-    let objects = |scene: &Scene| -> Vec<serde_json::Value> {
-        (scene.objects.iter())
-            .map(|o| {
-                let m = &o.material;
-                let material = json!({
-                    "ambient": v(m.ambient),
-                    "diffuse": v(m.diffuse),
-                    "specular": v(m.specular),
-                    "shininess": m.shininess,
-                    "reflection": m.reflection,
-                });
-                let entry = match o.role {
-                    Role::Sphere => "sphere",
-                    Role::Floor => "plane",
-                };
-                match o.shape {
-                    Shape::Sphere(sp) => json!({
-                        "entry": entry,
-                        "shape": "sphere",
-                        "center": v(sp.center),
-                        "radius": sp.radius,
-                        "material": material,
-                    }),
-                    Shape::Plane(p) => json!({
-                        "entry": entry,
-                        "shape": "plane",
-                        "point": v(p.point),
-                        "normal": v(p.normal),
-                        "material": material,
-                    }),
-                }
-            })
-            .collect()
+    let object = |o: &crate::scene::Object| {
+        let m = &o.material;
+        let material = json!({
+            "ambient": v(m.ambient),
+            "diffuse": v(m.diffuse),
+            "specular": v(m.specular),
+            "shininess": m.shininess,
+            "reflection": m.reflection,
+        });
+        let entry = match o.role {
+            Role::Sphere => "sphere",
+            Role::Floor => "plane",
+        };
+        match o.shape {
+            Shape::Sphere(sp) => json!({
+                "entry": entry,
+                "shape": "sphere",
+                "center": v(sp.center),
+                "radius": sp.radius,
+                "material": material,
+            }),
+            Shape::Plane(p) => json!({
+                "entry": entry,
+                "shape": "plane",
+                "point": v(p.point),
+                "normal": v(p.normal),
+                "material": material,
+            }),
+        }
     };
     let l = &scene.light;
     let mut described = json!({
@@ -95,7 +91,7 @@ pub fn scene_json(scene: &Scene, name: &str, listed: bool) -> serde_json::Value 
         "object_count": scene.objects.len(),
     });
     if listed {
-        described["objects"] = serde_json::Value::Array(objects(scene));
+        described["objects"] = scene.objects.iter().map(object).collect();
     }
     described
 }
