@@ -30,7 +30,7 @@ pub enum Accel {
     /// tile masks for primary rays.
     #[default]
     Auto,
-    /// A BVH whatever the number of spheres (but never with `--intersect naive`).
+    /// A BVH whatever the number of spheres (but never with --intersect naive).
     Bvh,
 }
 

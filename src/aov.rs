@@ -15,7 +15,7 @@
 //! | `object` | `intersection` on | index of the object hit first, among the objects in play (the file's spheres in file order, then those of its `[generate]` section, then the `[[plane]]` entries); `−1` on a miss |
 //! | `ambient`, `diffuse`, `specular` | `blinn-phong` on | the three Blinn-Phong terms of the first hit (`ka·la`, `kd·ld·(L·N)`, `ks·ls·(N·H)^(shininess/4)`), as added to the pixel; `0` in shadow and on a miss, where none is computed |
 //! | `bounces` | `reflection` on | reflected rays the pixel's path traced: 0 to `max_depth − 1` |
-//! | `rays` | `intersection` on | every ray the pixel traced (primary, shadow and reflected, of every sample): where the time goes |
+//! | `rays` | `intersection` on | every ray the pixel traced (primary, shadow and reflected, of the centre ray and of every sample): where the time goes |
 
 use rayon::prelude::*;
 
@@ -111,7 +111,8 @@ impl Buffer {
 /// Rays traced, by kind: what the `rays` buffer and `raystep bench` count.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Rays {
-    /// Rays from the camera (one per pixel and sample).
+    /// Rays from the camera: one a pixel, the centre ray the buffers describe,
+    /// and with `--spp N` (N > 1) N more, the samples.
     pub primary: u64,
     /// Rays from a hit point towards the light.
     pub shadow: u64,

@@ -76,7 +76,8 @@ impl From<Stages> for Settings {
 
 impl Settings {
     /// The tutorial's program exactly: float64, the textbook quadratic, the fixed
-    /// 1e-5 step, the camera as the viewer.
+    /// 1e-5 step, the camera as the viewer, and no early stop (a path goes on to
+    /// `max_depth` segments however little the rest of it can add).
     pub fn tutorial(stages: Stages) -> Settings {
         Settings {
             precision: Precision::F64,
@@ -153,7 +154,8 @@ pub enum End {
 /// nothing unless an observer says otherwise, so watching costs nothing where no
 /// one watches (`()`).
 pub trait Observer<T: Real> {
-    /// A primary ray was made (once per pixel and sample).
+    /// A primary ray was made: the centre ray of each pixel, and with samples
+    /// (`--spp N`, N > 1) each sample's too.
     fn primary(&mut self, _ray: &Ray<T>) {}
     /// Segment `index` of the path starts: `ray`, whose light counts `weight`.
     fn segment(&mut self, _index: u32, _ray: &Ray<T>, _weight: T) {}

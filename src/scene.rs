@@ -99,7 +99,8 @@ pub struct Scene {
     pub light: Light,
     /// Most segments of a pixel's path (the primary ray and its reflections).
     pub max_depth: u32,
-    /// Spheres first, in file order, then the `[[plane]]` entries, in file order.
+    /// The `[[sphere]]` entries in file order, then the spheres of `[generate]`,
+    /// then the `[[plane]]` entries in file order.
     pub objects: Vec<Object>,
 }
 

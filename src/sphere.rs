@@ -17,10 +17,10 @@ pub struct Sphere<T: Real = f64> {
 /// How the quadratic is solved (`--intersect`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum Method {
-    /// The tutorial's: `Δ = b² − 4c`, roots `(−b ± √Δ)/2`.
+    /// The tutorial's: Δ = b² − 4c, roots (−b ± √Δ)/2.
     Naive,
     /// Ray Tracing Gems, chapter 7: Δ from the ray's closest approach to the centre,
-    /// roots `q` and `c/q` (no subtraction of nearly equal numbers).
+    /// roots q and c/q (no subtraction of nearly equal numbers).
     #[default]
     Stable,
 }
@@ -100,8 +100,8 @@ impl<T: Real> Sphere<T> {
 impl<T: Real> Sphere<T> {
     /// The same two roots, computed so that no step subtracts nearly equal numbers.
     ///
-    /// With `m = C − O` (from the origin to the centre) and the half-coefficient
-    /// `h = ⟨d, m⟩` (the distance along the ray to the point closest to the centre),
+    /// With `m = C − O` (from the origin to the centre) and `h = ⟨d, m⟩ = −b/2`
+    /// (the distance along the ray to the point closest to the centre),
     /// the roots are `h ± √(Δ/4)`, and `Δ/4 = r² − ‖h·d − m‖²`: the radius squared
     /// minus the squared distance from the centre to that closest point. The
     /// textbook `b² − 4c` computes the same number as the difference of two large

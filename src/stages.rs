@@ -46,9 +46,9 @@ pub enum Stage {
     Shadow,
     /// Ambient + diffuse + specular light.
     BlinnPhong,
-    /// Mirror bounces, up to `max_depth` segments per pixel.
+    /// Mirror bounces, up to max_depth segments per pixel.
     Reflection,
-    /// The scene's `[[plane]]` entries (the floor) take part.
+    /// The floor (the scene's plane entries) takes part.
     Plane,
 }
 

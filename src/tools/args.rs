@@ -21,12 +21,12 @@ use crate::stages::{Engine, Stage, Stages};
 
 /// raystep: a ray tracer that teaches ray tracing one step at a time.
 ///
-/// With no command, renders every stage of the built-in figure-1 scene into `out/`
-/// (the same as `raystep stages`).
+/// With no command, renders every stage of the built-in figure-1 scene into out/
+/// (the same as raystep stages).
 #[derive(Parser, Debug)]
 #[command(name = "raystep", version, about, long_about, after_help = LIMITS)]
 pub struct Cli {
-    /// What to do (default: `stages` on the built-in scene).
+    /// What to do (default: stages on the built-in scene).
     #[command(subcommand)]
     pub command: Option<Command>,
     /// Print no status lines (what is being rendered, the files written, the
@@ -134,8 +134,8 @@ pub struct ExplainArgs {
     /// The pixel: column and row from the top-left corner, e.g. 150,120.
     #[arg(long, value_parser = parse_pixel)]
     pub pixel: (u32, u32),
-    /// Print one JSON object instead of the story in words (`depth`: the first
-    /// hit's distance, null on a miss).
+    /// Print one JSON object instead of the story in words (its depth is the
+    /// first hit's distance, null on a miss).
     #[arg(long)]
     pub json: bool,
 }
@@ -166,7 +166,7 @@ pub struct ChartArgs {
     #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..=10_000_000), requires = "scale")]
     pub max_count: u64,
     /// With --scale, also time the Embree program at PATH on each scene (built by
-    /// `benches/embree/run.sh build`), drawn beside raystep's points.
+    /// benches/embree/run.sh build), drawn beside raystep's points.
     #[arg(long, value_name = "PATH", requires = "scale")]
     pub embree: Option<PathBuf>,
     /// Where the CSV and the charts go.
