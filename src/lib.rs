@@ -16,8 +16,9 @@
 //!
 //! The modules below are listed in the order the book introduces them, so this
 //! file reads as its table of contents.
-// One place only, with its reason: the call of the packet loop's AVX build once
-// the processor is found to have AVX (`Fast::packet_row`, fast/mod.rs).
+// One place only, with its reason: the packet loop's AVX build, declared
+// `unsafe` for its target feature, and its call once the processor is found to
+// have AVX (`Fast::packet_row`, fast/mod.rs).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 

@@ -44,7 +44,8 @@
 //! [`BVH_FROM`](crate::accel::BVH_FROM) spheres on with `--accel auto`, always
 //! with `--accel bvh`) through it, which a packet walks together
 //! (`Bvh::search_packet`, in `src/fast/walk.rs`), and one without, of up to
-//! [`MAX_OBJECTS`] objects, by the plain loop (with the tile masks). A larger
+//! [`MAX_OBJECTS`] objects, by the plain loop (with the tile masks under
+//! `--accel auto`). A larger
 //! scene without a BVH (`--accel off`, or `--intersect naive`), or a render with
 //! a stage `knows` does not list, is left to the book's row loop, one ray at a
 //! time.

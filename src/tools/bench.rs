@@ -66,16 +66,16 @@ pub struct Report {
     /// Median seconds of the set-up and what follows the rows: the frame's time
     /// less its rows' time, run by run.
     pub setup_s: f64,
-    /// Median seconds per frame with one thread (absent when `threads` is 1).
+    /// Median seconds per frame with one thread (null when `threads` is 1).
     pub one_thread_median_s: Option<f64>,
     /// `one_thread_median_s / median_s`.
     pub thread_speedup: Option<f64>,
-    /// Median seconds of the rows alone with one thread (absent when `threads`
+    /// Median seconds of the rows alone with one thread (null when `threads`
     /// is 1).
     pub one_thread_trace_s: Option<f64>,
     /// `one_thread_trace_s / trace_s`: the rows' own speed-up.
     pub trace_thread_speedup: Option<f64>,
-    /// Median seconds per frame of the yardstick (absent for a scene with a true
+    /// Median seconds per frame of the yardstick (null for a scene with a true
     /// plane, which the tutorial's program cannot draw, or with `--no-yardstick`).
     pub yardstick_median_s: Option<f64>,
     /// Rays per frame of the yardstick, counted per pixel and summed after the
@@ -92,7 +92,7 @@ pub struct Report {
     /// `yardstick_median_s / other_median_s`.
     pub other_yardstick_ratio: Option<f64>,
     /// Median seconds to build the BVH over the scene's spheres with `threads`
-    /// threads, timed in turn with the renders (absent when the render uses no
+    /// threads, timed in turn with the renders (null when the render uses no
     /// BVH). The render's own build is part of `median_s`.
     pub bvh_build_s: Option<f64>,
     /// Nodes of that BVH.
