@@ -387,7 +387,11 @@ fn the_numbers_the_chapters_quote_are_measured_again() {
         .count();
     assert_quotes(
         "07",
-        &format!("{} pixels differ by more than one 8-bit step (2.26 % of the picture), and {near_horizon} of\nthem lie in rows 97 to 108", d.over_one_step),
+        &format!(
+            "{} pixels differ by more than one 8-bit step ({:.2} % of the picture), and {near_horizon} of\nthem lie in rows 97 to 108",
+            d.over_one_step,
+            100.0 * d.over_one_step as f64 / d.pixels as f64
+        ),
     );
     // Chapter 8: the viewer on a bounce, with the tutorial's rules; the whole
     // `raystep diff` report is quoted.

@@ -224,19 +224,42 @@ mod tests {
         }
     }
 
-    /// The float64 slab test of [`Bvh::enter`] on the box `min`..`max`.
+    /// The float64 slab test of [`Bvh::enter`] on the box `min`..`max`, where it
+    /// enters. A ray parallel to a slab (a direction component of zero) lies in
+    /// it, faces included, along its whole length, or never: taken apart, not
+    /// as `0·∞`, which is NaN for an origin on a face.
     fn enters_exact(min: Vec3, max: Vec3, origin: Vec3, direction: Vec3) -> Option<f64> {
-        let inverse = Vec3::ONE / direction;
-        let (t1, t2) = ((min - origin) * inverse, (max - origin) * inverse);
-        let near = t1.min(t2).max_element().max(0.0);
-        let far = t1.max(t2).min_element();
+        let (mut near, mut far) = (0.0f64, f64::INFINITY);
+        for a in 0..3 {
+            if direction[a] == 0.0 {
+                if origin[a] < min[a] || origin[a] > max[a] {
+                    return None;
+                }
+                continue;
+            }
+            let (t1, t2) = (
+                (min[a] - origin[a]) / direction[a],
+                (max[a] - origin[a]) / direction[a],
+            );
+            near = near.max(t1.min(t2));
+            far = far.min(t1.max(t2));
+        }
         (near <= far).then_some(near)
     }
 
     proptest::proptest! {
-        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(
-            std::env::var("RAYSTEP_PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(4000)
-        ))]
+        #![proptest_config({
+            let cases: u32 = std::env::var("RAYSTEP_PROPTEST_CASES")
+                .ok()
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(4000);
+            // Rays that float64 rounds out of the box are rejected: about 6 % of
+            // the cases (2 % of those along a face). A quarter fails the test.
+            proptest::prelude::ProptestConfig {
+                max_global_rejects: cases / 4,
+                ..proptest::prelude::ProptestConfig::with_cases(cases)
+            }
+        })]
 
         /// The float32 box test of the packet walk never skips a sphere's box that
         /// the float64 test enters, for rays that graze the box's faces, edges and
@@ -275,9 +298,11 @@ mod tests {
             }
             let direction = (p - origin).normalize();
             proptest::prop_assume!(direction.is_finite());
-            let Some(t) = enters_exact(min, max, origin, direction) else {
-                return Ok(()); // rounded out of the box in float64: nothing to check
-            };
+            // A ray rounded out of the box in float64 has nothing to check; too
+            // many such cases fail the test (proptest's limit of rejects).
+            let t = enters_exact(min, max, origin, direction);
+            proptest::prop_assume!(t.is_some(), "rounded out of the box in float64");
+            let t = t.unwrap();
             let lanes = |v: Vec3| V3::<f64>::splat(v).convert::<f32>();
             // As the walk makes them: the reciprocal of the float32 direction.
             let (o, d) = (lanes(origin), lanes(direction));

