@@ -151,6 +151,8 @@ mod tests {
         assert_eq!(linspace(-1.0, 1.0, 1919, 1920), 1.0);
         assert_eq!(linspace(-1.0f32, 1.0, 0, 1), -1.0);
         // Chapter 2's count: of 1920 columns, this many would move by dividing last.
+        // Python's floats give the same 927: `step = 2/1919; g = [-1 + j*step for j
+        // in range(1920)]; g[-1] = 1.0; sum(g[j] != -1 + j*2/1919 for j in range(1920))`.
         let divided_last = (0..1920u32)
             .filter(|&j| linspace(-1.0, 1.0, j, 1920) != -1.0 + f64::from(j) * 2.0 / 1919.0)
             .count();
