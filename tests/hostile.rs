@@ -1017,7 +1017,7 @@ fn a_commit_puts_every_file_in_place_or_none() {
 fn temporaries_are_removed_even_from_a_folder_moved_during_the_render() {
     let dir = tempfile::tempdir().unwrap();
     let root = dir.path();
-    let child = Command::new(env!("CARGO_BIN_EXE_raystep"))
+    let mut child = Command::new(env!("CARGO_BIN_EXE_raystep"))
         .args([
             "stages", "--width", "960", "--height", "540", "--out", "out",
         ])
@@ -1026,20 +1026,19 @@ fn temporaries_are_removed_even_from_a_folder_moved_during_the_render() {
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    // The folder is made at the start; move it away while the stages render.
-    let started = Instant::now();
-    while !root.join("out").is_dir() {
-        assert!(
-            started.elapsed() < Duration::from_secs(20),
-            "no output folder"
-        );
-        std::thread::sleep(Duration::from_millis(20));
+    // Move the folder away once the first stage is done (its status line says
+    // so) and five are still to render, however fast the machine: the files of
+    // every stage are put in place only at the end.
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut said = String::new();
+    while !said.contains("out/01-rays/") {
+        let read = std::io::BufRead::read_line(&mut stderr, &mut said).unwrap();
+        assert!(read > 0, "no status line for the first stage: {said}");
     }
-    std::thread::sleep(Duration::from_millis(500));
     std::fs::rename(root.join("out"), root.join("moved")).unwrap();
-    let out = child.wait_with_output().unwrap();
-    let said = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{said}");
+    std::io::Read::read_to_string(&mut stderr, &mut said).unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(2), "{said}");
     assert!(
         said.contains("was moved or replaced while raystep rendered into it")
             || said.contains("No such file or directory"),
