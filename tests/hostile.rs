@@ -751,6 +751,33 @@ fn threads_that_cannot_start_are_a_message_not_a_panic() {
 }
 
 #[test]
+fn a_command_that_hangs_fails_its_test_instead_of_stalling_the_suite() {
+    // Every test runs raystep through `common::raystep`, which kills a command
+    // that outlives its limit and fails: here `check` of a FIFO nobody writes.
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("fifo.toml");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let started = Instant::now();
+    let hung = std::panic::catch_unwind(|| {
+        common::raystep_within(dir.path(), &["check", "fifo.toml"], Duration::from_secs(1))
+    });
+    let message = *hung
+        .expect_err("a hang passed")
+        .downcast::<String>()
+        .unwrap();
+    assert!(message.contains("still ran after 1s: killed"), "{message}");
+    assert!(started.elapsed() < Duration::from_secs(10));
+    // Within its limit the same command ends as `Command::output` would.
+    std::fs::write(dir.path().join("ok.toml"), OK_SCENE).unwrap();
+    let out = common::raystep(dir.path(), &["check", "ok.toml"]);
+    assert!(out.status.success() && !out.stdout.is_empty());
+}
+
+#[test]
 fn one_signal_ends_any_command_within_a_second_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("ok.toml"), OK_SCENE).unwrap();

@@ -77,13 +77,64 @@ pub fn read_pfm(bytes: &[u8]) -> (usize, usize, Vec<[f32; 3]>) {
     (w, h, rows)
 }
 
-/// Run the `raystep` binary with `args` in the folder `dir`.
+/// The longest a test lets one `raystep` command run (the longest run of a
+/// test's commands takes a few seconds; a debug build on a loaded machine ten
+/// times as long).
+pub const RUN_LIMIT: std::time::Duration = std::time::Duration::from_secs(180);
+
+/// Run the `raystep` binary with `args` in the folder `dir`, as
+/// `Command::output` does (no standard input, both outputs read whole), but a
+/// command still running after [`RUN_LIMIT`] is killed and fails the test: a
+/// hang is a failure, not a suite that never ends.
 pub fn raystep(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_raystep"))
+    raystep_within(dir, args, RUN_LIMIT)
+}
+
+/// [`raystep`] with a limit of its own.
+pub fn raystep_within(
+    dir: &std::path::Path,
+    args: &[&str],
+    limit: std::time::Duration,
+) -> std::process::Output {
+    use std::io::Read;
+    use std::process::Stdio;
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_raystep"))
         .args(args)
         .current_dir(dir)
-        .output()
-        .expect("the binary runs")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    // Each output read on a thread of its own, so that neither pipe fills.
+    fn read_all(mut pipe: impl Read + Send + 'static) -> std::thread::JoinHandle<Vec<u8>> {
+        std::thread::spawn(move || {
+            let mut bytes = Vec::new();
+            pipe.read_to_end(&mut bytes).expect("the output reads");
+            bytes
+        })
+    }
+    let stdout = read_all(child.stdout.take().unwrap());
+    let stderr = read_all(child.stderr.take().unwrap());
+    let started = std::time::Instant::now();
+    let mut pause = std::time::Duration::from_millis(1);
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("the binary is waited for") {
+            break status;
+        }
+        if started.elapsed() > limit {
+            child.kill().ok();
+            child.wait().ok();
+            panic!("raystep {args:?} still ran after {limit:?}: killed");
+        }
+        std::thread::sleep(pause);
+        pause = (pause * 2).min(std::time::Duration::from_millis(20));
+    };
+    std::process::Output {
+        status,
+        stdout: stdout.join().unwrap(),
+        stderr: stderr.join().unwrap(),
+    }
 }
 
 /// What chapter `file` (in `chapters/`) shows after the line `$ COMMAND`, up to
