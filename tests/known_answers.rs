@@ -84,6 +84,24 @@ fn lit_head_on_the_centre_pixel_is_ambient_plus_diffuse_plus_specular() {
 }
 
 #[test]
+fn each_term_takes_its_own_colour_of_the_light() {
+    // The light's three colours told apart, one channel each: the ambient term
+    // is red only, the diffuse green only, the specular blue only. Head on,
+    // every factor is 1, so the pixel is (ka·la_r, kd·ld_g, ks·ls_b).
+    let scene = ONE_SPHERE.replace(
+        "[light]\nposition = [0, 0, 1]",
+        "[light]\nposition = [0, 0, 1]\nambient = [1, 0, 0]\ndiffuse = [0, 1, 0]\nspecular = [0, 0, 1]",
+    );
+    assert_ne!(scene, ONE_SPHERE);
+    let frame = common::render(&common::scene(&scene), Stages::ALL);
+    let c = frame.at(2, 2).colour;
+    let expected = [0.1, 0.5, 0.25];
+    for k in 0..3 {
+        assert!((c[k] - expected[k]).abs() < 1e-6, "{c:?}");
+    }
+}
+
+#[test]
 fn the_exr_holds_the_exact_depth_of_a_pixel() {
     let frame = common::render(&common::scene(ONE_SPHERE), Stages::ALL);
     let dir = tempfile::tempdir().unwrap();
@@ -137,6 +155,12 @@ fn normals_are_unit_length_on_hits_and_zero_on_misses() {
 
 /// A floor sphere, an occluder above its top, the light above both.
 fn occluder_scene(occluder_x: f64) -> raystep::scene::Scene {
+    occluder_at(occluder_x, 2.0)
+}
+
+/// The floor sphere's top at (0, 0, −2), the light 5 above it at (0, 5, −2), and
+/// an occluder of radius 0.5 at (x, y, −2).
+fn occluder_at(occluder_x: f64, occluder_y: f64) -> raystep::scene::Scene {
     common::scene(&format!(
         r#"
         [camera]
@@ -147,7 +171,7 @@ fn occluder_scene(occluder_x: f64) -> raystep::scene::Scene {
         center = [0, -1, -2]
         radius = 1
         [[sphere]]
-        center = [{occluder_x}, 2, -2]
+        center = [{occluder_x}, {occluder_y}, -2]
         radius = 0.5
         "#
     ))
@@ -171,6 +195,19 @@ fn a_point_behind_an_occluder_is_in_shadow_and_black() {
     let open = Tracer::<f64>::new(&occluder_scene(3.0), &Stages::ALL.into()).trace(down, &mut ());
     assert!(open.first.unwrap().lit);
     assert!(open.colour.max_element() > 0.5);
+
+    // Along the whole way to the light and no farther: an occluder from 3.5 to
+    // 4.5 above the point, of the light's 5, shadows it; one from 5.5 to 6.5,
+    // past the light, does not.
+    let lit_with = |y: f64| {
+        Tracer::<f64>::new(&occluder_at(0.0, y), &Stages::ALL.into())
+            .trace(down, &mut ())
+            .first
+            .unwrap()
+            .lit
+    };
+    assert!(!lit_with(4.0), "an occluder near the light");
+    assert!(lit_with(6.0), "an object beyond the light");
 
     // Without the shadow stage no shadow ray is cast: the point reads lit.
     let no_shadow = Stages::select(Stage::Plane, &[Stage::Shadow]).unwrap();
