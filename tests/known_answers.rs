@@ -1,6 +1,8 @@
 //! Renders with answers known in advance, in the style of pbrt's tests: analytic
-//! depths, unit normals, a point behind an occluder, rays re-cast from a hit point,
-//! `--without` equal to the stage before, and the same bytes on any thread count.
+//! depths, unit normals, each light colour in its own term, a float32 render's
+//! depths, a point behind an occluder (and not behind an object past the light),
+//! rays re-cast from a hit point, `--without` equal to the stage before, and the
+//! same bytes on any thread count.
 
 mod common;
 
@@ -99,6 +101,41 @@ fn each_term_takes_its_own_colour_of_the_light() {
     for k in 0..3 {
         assert!((c[k] - expected[k]).abs() < 1e-6, "{c:?}");
     }
+}
+
+#[test]
+fn a_float32_render_is_traced_in_float32() {
+    // `--precision f32` runs the book's tracer on float32 numbers: every hit's
+    // depth is the float32 tracer's, and some are not the float64 tracer's.
+    let scene = common::seed(60, 40);
+    let settings = Settings {
+        precision: raystep::real::Precision::F32,
+        ..Settings::from(Stages::ALL)
+    };
+    let frame = raystep::render::render(&scene, &settings, &|_| {});
+    let camera = scene.camera();
+    let narrow = Tracer::<f32>::new(&scene, &settings);
+    let wide = Tracer::<f64>::new(&scene, &Settings::from(Stages::ALL));
+    let (mut hits, mut apart) = (0, 0);
+    for row in 0..40 {
+        for col in 0..60 {
+            let depth = |first: Option<raystep::aov::FirstHit>| first.map(|f| f.depth as f32);
+            let in_f32 = depth(narrow.trace(camera.primary_ray(row, col), &mut ()).first);
+            let in_f64 = depth(wide.trace(camera.primary_ray(row, col), &mut ()).first);
+            let record = frame.at(row, col);
+            assert_eq!(in_f32.is_some(), record.is_hit(), "({row}, {col})");
+            if let Some(d) = in_f32 {
+                assert_eq!(d, record.depth, "({row}, {col})");
+                hits += 1;
+                apart += usize::from(in_f64 != Some(d));
+            }
+        }
+    }
+    assert!(hits > 1000, "{hits} hits");
+    assert!(
+        apart > hits / 10,
+        "{apart} of {hits} depths differ in float64"
+    );
 }
 
 #[test]
