@@ -750,17 +750,18 @@ fn threads_that_cannot_start_are_a_message_not_a_panic() {
     );
 }
 
+/// A FIFO at `path`: a file that a reader waits on until someone writes it.
+fn make_fifo(path: &Path) {
+    let made = Command::new("mkfifo").arg(path).status().unwrap();
+    assert!(made.success(), "mkfifo {}", path.display());
+}
+
 #[test]
 fn a_command_that_hangs_fails_its_test_instead_of_stalling_the_suite() {
     // Every test runs raystep through `common::raystep`, which kills a command
     // that outlives its limit and fails: here `check` of a FIFO nobody writes.
     let dir = tempfile::tempdir().unwrap();
-    let fifo = dir.path().join("fifo.toml");
-    assert!(Command::new("mkfifo")
-        .arg(&fifo)
-        .status()
-        .unwrap()
-        .success());
+    make_fifo(&dir.path().join("fifo.toml"));
     let started = Instant::now();
     let hung = std::panic::catch_unwind(|| {
         common::raystep_within(dir.path(), &["check", "fifo.toml"], Duration::from_secs(1))
@@ -781,9 +782,7 @@ fn a_command_that_hangs_fails_its_test_instead_of_stalling_the_suite() {
 fn one_signal_ends_any_command_within_a_second_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("ok.toml"), OK_SCENE).unwrap();
-    let fifo = dir.path().join("fifo.toml");
-    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
-    assert!(made.success(), "mkfifo");
+    make_fifo(&dir.path().join("fifo.toml"));
     let before = names(dir.path());
     // Reading a FIFO that nobody writes, a benchmark of many runs, a chart: none
     // of them looks at the flag the first signal raises.

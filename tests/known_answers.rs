@@ -116,10 +116,10 @@ fn a_float32_render_is_traced_in_float32() {
     let camera = scene.camera();
     let narrow = Tracer::<f32>::new(&scene, &settings);
     let wide = Tracer::<f64>::new(&scene, &Settings::from(Stages::ALL));
+    let depth = |first: Option<raystep::aov::FirstHit>| first.map(|f| f.depth as f32);
     let (mut hits, mut apart) = (0, 0);
     for row in 0..40 {
         for col in 0..60 {
-            let depth = |first: Option<raystep::aov::FirstHit>| first.map(|f| f.depth as f32);
             let in_f32 = depth(narrow.trace(camera.primary_ray(row, col), &mut ()).first);
             let in_f64 = depth(wide.trace(camera.primary_ray(row, col), &mut ()).first);
             let record = frame.at(row, col);
@@ -190,13 +190,9 @@ fn normals_are_unit_length_on_hits_and_zero_on_misses() {
     assert!(hits > 0);
 }
 
-/// A floor sphere, an occluder above its top, the light above both.
-fn occluder_scene(occluder_x: f64) -> raystep::scene::Scene {
-    occluder_at(occluder_x, 2.0)
-}
-
-/// The floor sphere's top at (0, 0, −2), the light 5 above it at (0, 5, −2), and
-/// an occluder of radius 0.5 at (x, y, −2).
+/// A floor sphere, an occluder above its top, the light above both: the floor
+/// sphere's top at (0, 0, −2), the light 5 above it at (0, 5, −2), and an
+/// occluder of radius 0.5 at (x, y, −2).
 fn occluder_at(occluder_x: f64, occluder_y: f64) -> raystep::scene::Scene {
     common::scene(&format!(
         r#"
@@ -222,14 +218,14 @@ fn a_point_behind_an_occluder_is_in_shadow_and_black() {
         direction: -Vec3::Y,
     };
     let blocked =
-        Tracer::<f64>::new(&occluder_scene(0.0), &Stages::ALL.into()).trace(down, &mut ());
+        Tracer::<f64>::new(&occluder_at(0.0, 2.0), &Stages::ALL.into()).trace(down, &mut ());
     let hit = blocked.first.unwrap();
     assert_eq!(hit.depth, 1.0);
     assert!(!hit.lit);
     assert_eq!(blocked.colour, Vec3::ZERO);
 
     // The same point with the occluder moved aside is lit.
-    let open = Tracer::<f64>::new(&occluder_scene(3.0), &Stages::ALL.into()).trace(down, &mut ());
+    let open = Tracer::<f64>::new(&occluder_at(3.0, 2.0), &Stages::ALL.into()).trace(down, &mut ());
     assert!(open.first.unwrap().lit);
     assert!(open.colour.max_element() > 0.5);
 
@@ -249,7 +245,7 @@ fn a_point_behind_an_occluder_is_in_shadow_and_black() {
     // Without the shadow stage no shadow ray is cast: the point reads lit.
     let no_shadow = Stages::select(Stage::Plane, &[Stage::Shadow]).unwrap();
     assert!(
-        Tracer::<f64>::new(&occluder_scene(0.0), &no_shadow.into())
+        Tracer::<f64>::new(&occluder_at(0.0, 2.0), &no_shadow.into())
             .trace(down, &mut ())
             .first
             .unwrap()

@@ -137,11 +137,26 @@ pub fn raystep_within(
     }
 }
 
+/// The text of chapter `file` (in `chapters/`).
+pub fn chapter(file: &str) -> String {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::read_to_string(root.join("chapters").join(file))
+        .unwrap_or_else(|e| panic!("chapters/{file}: {e}"))
+}
+
+/// Chapter `file`'s words joined by single spaces: a quote found in it however
+/// the chapter's lines wrap it.
+pub fn chapter_words(file: &str) -> String {
+    chapter(file)
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// What chapter `file` (in `chapters/`) shows after the line `$ COMMAND`, up to
 /// the end of its code block: the transcript a test holds to the command.
 pub fn transcript(file: &str, command: &str) -> String {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let chapter = std::fs::read_to_string(root.join("chapters").join(file)).unwrap();
+    let chapter = chapter(file);
     let line = format!("$ {command}\n");
     let after = chapter
         .split(&line)
