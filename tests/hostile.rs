@@ -401,8 +401,35 @@ fn send(signal: &str, pid: u32) {
     assert!(status.success(), "kill {signal} {pid}");
 }
 
-/// Run `args` in `dir` and send `signal` after `delay` (if it is still running);
-/// returns its exit code (None: ended by the signal).
+/// Wait until `child` catches SIGINT and SIGTERM, as the `SigCgt` mask of
+/// `/proc/PID/status` shows once raystep has set its handlers: a signal sent
+/// earlier would meet the default action and end the process at once, which is
+/// not what these tests ask about. (Sleeping a while instead guessed how long a
+/// start takes on a busy machine.) Returns early if the process has ended.
+fn wait_for_handlers(child: &mut std::process::Child) {
+    // Bits 1 and 14: signals 2 (SIGINT) and 15 (SIGTERM), counted from 1.
+    let wanted = (1u64 << 1) | (1u64 << 14);
+    let status = format!("/proc/{}/status", child.id());
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while child.try_wait().unwrap().is_none() {
+        let text = std::fs::read_to_string(&status).unwrap_or_default();
+        let caught = text
+            .lines()
+            .find_map(|line| line.strip_prefix("SigCgt:"))
+            .and_then(|hex| u64::from_str_radix(hex.trim(), 16).ok());
+        if caught.is_some_and(|mask| mask & wanted == wanted) {
+            return;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "no handler for SIGINT and SIGTERM after 60 s: {text:?}"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
+/// Run `args` in `dir` and send `signal` `delay` after its handlers are set (if
+/// it is still running); returns its exit code (None: ended by the signal).
 fn interrupted(dir: &Path, args: &[&str], signal: &str, delay: Duration) -> Option<i32> {
     let mut child = Command::new(env!("CARGO_BIN_EXE_raystep"))
         .args(args)
@@ -411,6 +438,7 @@ fn interrupted(dir: &Path, args: &[&str], signal: &str, delay: Duration) -> Opti
         .stderr(std::process::Stdio::null())
         .spawn()
         .unwrap();
+    wait_for_handlers(&mut child);
     std::thread::sleep(delay);
     if child.try_wait().unwrap().is_none() {
         send(signal, child.id());
@@ -810,7 +838,10 @@ fn one_signal_ends_any_command_within_a_second_and_writes_nothing() {
             .stderr(std::process::Stdio::null())
             .spawn()
             .unwrap();
-        std::thread::sleep(Duration::from_millis(400));
+        // Its handlers set, then a moment to be at its work (any moment would
+        // do: none of these commands looks at the flag).
+        wait_for_handlers(&mut child);
+        std::thread::sleep(Duration::from_millis(100));
         assert!(
             child.try_wait().unwrap().is_none(),
             "{args:?} ended by itself"

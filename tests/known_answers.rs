@@ -1,8 +1,9 @@
 //! Renders with answers known in advance, in the style of pbrt's tests: analytic
 //! depths, unit normals, each light colour in its own term, a float32 render's
 //! depths, a point behind an occluder (and not behind an object past the light),
-//! rays re-cast from a hit point, `--without` equal to the stage before, and the
-//! same bytes on any thread count.
+//! rays re-cast from a hit point, `--without` equal to the stage before, the
+//! levels of `--spp`'s samples, the segment at which early stop ends a path
+//! between two mirrors, and the same bytes on any thread count.
 
 mod common;
 
@@ -411,6 +412,130 @@ fn without_shadow_every_hit_is_plain_blinn_phong_even_where_it_is_negative() {
         }
     }
     assert!(black > 0, "the far sides, where L·N < 0, clip to black");
+}
+
+/// `--spp N` colours a pixel with the mean of N stratified samples, while its
+/// buffers keep the centre ray's first hit. In the intersection stage a hit is
+/// the sphere's flat diffuse colour (0.5) and a miss black, so with N samples
+/// every channel is k · 0.5 / N for the k samples that hit: the pixels the
+/// silhouette crosses take the levels between, the others 0 or 0.5.
+#[test]
+fn several_samples_average_the_pixel_and_leave_its_buffers_as_one_sample_has_them() {
+    let mut scene = common::scene(ONE_SPHERE);
+    (scene.width, scene.height) = (21, 21);
+    let render = |spp: u32| {
+        let settings = Settings {
+            spp,
+            ..Settings::from(Stages::up_to(Stage::Intersection))
+        };
+        raystep::render::render(&scene, &settings, &|_| {})
+    };
+    let one = render(1);
+    for spp in [1, 4, 9] {
+        let frame = render(spp);
+        let mut levels = std::collections::BTreeSet::new();
+        for row in 0..21 {
+            for col in 0..21 {
+                let (p, q) = (frame.at(row, col), one.at(row, col));
+                // The buffers are the centre ray's, whatever the sample count.
+                let buffers = |r: &raystep::aov::PixelRecord| {
+                    (r.depth, r.normal, r.shadow, r.object, r.bounces)
+                };
+                assert_eq!(buffers(p), buffers(q), "({row}, {col}) at {spp} spp");
+                // The centre ray, then the samples (no shadow ray, no bounce).
+                assert_eq!(p.rays, if spp > 1 { spp + 1 } else { 1 });
+                let hits = f64::from(p.colour[0]) / 0.5 * f64::from(spp);
+                let k = hits.round();
+                assert!(
+                    (hits - k).abs() < 1e-5 && (0.0..=f64::from(spp)).contains(&k),
+                    "({row}, {col}) at {spp} spp: {:?}",
+                    p.colour
+                );
+                assert!(p.colour.iter().all(|&c| c == p.colour[0]));
+                levels.insert(k as u32);
+            }
+        }
+        // Misses, full hits and levels between them: a render that traced the
+        // centre ray alone would show only 0 and N.
+        let between = levels.iter().filter(|&&k| k > 0 && k < spp).count();
+        assert!(levels.contains(&0) && levels.contains(&spp), "{levels:?}");
+        assert!(
+            between >= usize::from(spp > 1) * 2,
+            "at {spp} spp: {levels:?}"
+        );
+    }
+}
+
+/// Early stop ends a path once the most that its remaining segments could add
+/// is under half an 8-bit step. Between two facing mirrors of reflection ρ = ½
+/// the centre ray bounces along the axis, every segment lit; the most that k
+/// segments of weight 1 can add is B·(1 + ρ + … + ρᵏ⁻¹) with B = ka + kd + ks.
+/// The path ends after the first segment s whose weight ρˢ⁺¹ times that for the
+/// segments left falls under the half step: with 10 segments, s = 8 here, one
+/// reflection before the last, where counting one segment too many would give
+/// s = 9.
+#[test]
+fn early_stop_ends_a_path_between_two_mirrors_at_the_segment_its_rule_gives() {
+    let corridor = r#"
+[image]
+width = 3
+height = 3
+[camera]
+position = [0, 0, 1]
+[light]
+position = [0, 5, 1]
+ambient = [1, 1, 1]
+diffuse = [1, 1, 1]
+specular = [1, 1, 1]
+[render]
+max_depth = 10
+[[sphere]]
+center = [0, 0, -3]
+radius = 1
+ambient = [0.25, 0.25, 0.25]
+diffuse = [0.5, 0.5, 0.5]
+specular = [0.25, 0.25, 0.25]
+reflection = 0.5
+[[sphere]]
+center = [0, 0, 5]
+radius = 1
+ambient = [0.25, 0.25, 0.25]
+diffuse = [0.5, 0.5, 0.5]
+specular = [0.25, 0.25, 0.25]
+reflection = 0.5
+"#;
+    let scene = common::scene(corridor);
+    let (rho, most, segments) = (0.5f64, 1.0f64, 10u32);
+    let reach = |k: u32| (0..k).map(|i| rho.powi(i as i32) * most).sum::<f64>();
+    let stop_with = |left: &dyn Fn(u32) -> u32| {
+        (0..segments)
+            .find(|&s| rho.powi(s as i32 + 1) * reach(left(s)) < raystep::render::HALF_STEP)
+            .unwrap()
+    };
+    let stop = stop_with(&|s| segments - s - 1);
+    assert_eq!(stop, 8);
+    // The scene tells the count apart: one segment too many gives another s.
+    assert_ne!(stop_with(&|s| segments - s), stop);
+
+    let render = |early_stop: bool| {
+        let settings = Settings {
+            early_stop,
+            ..Settings::from(Stages::ALL)
+        };
+        *raystep::render::render(&scene, &settings, &|_| {}).at(1, 1)
+    };
+    let (stopped, whole) = (render(true), render(false));
+    // Every segment hits a mirror head on and is lit: s + 1 segments, s
+    // reflections, one shadow ray a segment, one primary ray.
+    assert_eq!(stopped.depth, 3.0);
+    assert_eq!(stopped.bounces, stop);
+    assert_eq!(stopped.rays, 1 + stop + (stop + 1));
+    assert_eq!(whole.bounces, segments - 1);
+    assert_eq!(whole.rays, 1 + (segments - 1) + segments);
+    // What the stop left out moves no channel by an 8-bit level.
+    for k in 0..3 {
+        assert!((stopped.colour[k] - whole.colour[k]).abs() < 1.0 / 255.0);
+    }
 }
 
 #[test]
