@@ -6,7 +6,8 @@
 //! [`crate::io::output::Pending`]). Work that does not look at the flag (reading a
 //! FIFO that nobody writes, a benchmark's runs, the accuracy measurements) is ended
 //! by a watchdog [`GRACE`] later: it waits for any renaming under way to finish
-//! ([`files`]), removes the temporary files of this process, and exits, unless the
+//! ([`files`]), removes the temporary files of this process, says so
+//! ([`WATCHDOG_MESSAGE`]) and exits, unless the
 //! new files were put in place meanwhile ([`committed`]): the command then ends by
 //! itself, with its own exit code. A second
 //! signal ends the process at once; the temporary files it leaves are removed by
@@ -30,6 +31,10 @@ static MADE: Mutex<Vec<(PathBuf, bool)>> = Mutex::new(Vec::new());
 
 /// The exit code of a process ended by SIGINT, as shells report it (128 + 2).
 pub const EXIT_CODE: u8 = 130;
+
+/// What the watchdog says on standard error as it ends a command.
+pub const WATCHDOG_MESSAGE: &str =
+    "interrupted: stopped half a second after the signal, and nothing was written";
 
 /// How long after the first signal the watchdog ends a command that has not
 /// ended by itself.
@@ -61,6 +66,10 @@ pub fn install() {
                     false => std::fs::remove_file(path),
                 };
             }
+            // Said as the command's own errors are (and not lost if standard
+            // error is closed: `eprintln!` would panic).
+            use std::io::Write;
+            let _ = writeln!(std::io::stderr(), "error: {WATCHDOG_MESSAGE}");
             std::process::exit(i32::from(EXIT_CODE));
         });
     });

@@ -812,8 +812,9 @@ fn one_signal_ends_any_command_within_a_second_and_writes_nothing() {
     std::fs::write(dir.path().join("ok.toml"), OK_SCENE).unwrap();
     make_fifo(&dir.path().join("fifo.toml"));
     let before = names(dir.path());
-    // Reading a FIFO that nobody writes, a benchmark of many runs, a chart: none
-    // of them looks at the flag the first signal raises.
+    // Reading a FIFO that nobody writes, a benchmark of many runs, a chart: work
+    // that does not stop between rows (a chart's renders do, between its other
+    // work), ended by the watchdog.
     for (args, signal) in [
         (&["check", "fifo.toml"][..], "-INT"),
         (&["render", "fifo.toml", "--out", "out"], "-TERM"),
@@ -831,11 +832,12 @@ fn one_signal_ends_any_command_within_a_second_and_writes_nothing() {
             "-INT",
         ),
     ] {
+        let said = tempfile::NamedTempFile::new().unwrap();
         let mut child = Command::new(env!("CARGO_BIN_EXE_raystep"))
             .args(args)
             .current_dir(dir.path())
             .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::null())
+            .stderr(said.reopen().unwrap())
             .spawn()
             .unwrap();
         // Its handlers set, then a moment to be at its work (any moment would
@@ -859,6 +861,15 @@ fn one_signal_ends_any_command_within_a_second_and_writes_nothing() {
             std::thread::sleep(Duration::from_millis(20));
         };
         assert_eq!(code, Some(130), "{args:?} after {signal}");
+        let stderr = std::fs::read_to_string(said.path()).unwrap();
+        // The watchdog's words, or the command's own if it stopped first (a
+        // chart's renders stop between rows).
+        let last = stderr.lines().last().unwrap_or_default();
+        assert!(
+            last == format!("error: {}", raystep::interrupt::WATCHDOG_MESSAGE)
+                || last == format!("error: {}", raystep::error::Error::Interrupted),
+            "{args:?} said {stderr:?}"
+        );
         assert!(
             sent.elapsed() < Duration::from_millis(1500),
             "{args:?}: {:?}",

@@ -476,35 +476,20 @@ fn several_samples_average_the_pixel_and_leave_its_buffers_as_one_sample_has_the
 /// s = 9.
 #[test]
 fn early_stop_ends_a_path_between_two_mirrors_at_the_segment_its_rule_gives() {
-    let corridor = r#"
-[image]
-width = 3
-height = 3
-[camera]
-position = [0, 0, 1]
-[light]
-position = [0, 5, 1]
-ambient = [1, 1, 1]
-diffuse = [1, 1, 1]
-specular = [1, 1, 1]
-[render]
-max_depth = 10
-[[sphere]]
-center = [0, 0, -3]
-radius = 1
-ambient = [0.25, 0.25, 0.25]
-diffuse = [0.5, 0.5, 0.5]
-specular = [0.25, 0.25, 0.25]
-reflection = 0.5
-[[sphere]]
-center = [0, 0, 5]
-radius = 1
-ambient = [0.25, 0.25, 0.25]
-diffuse = [0.5, 0.5, 0.5]
-specular = [0.25, 0.25, 0.25]
-reflection = 0.5
-"#;
-    let scene = common::scene(corridor);
+    // Two mirrors on the camera's axis, in front of it and behind it.
+    let mirror = |z: i32| {
+        format!(
+            "[[sphere]]\ncenter = [0, 0, {z}]\nradius = 1\nreflection = 0.5\n\
+             ambient = [0.25, 0.25, 0.25]\ndiffuse = [0.5, 0.5, 0.5]\nspecular = [0.25, 0.25, 0.25]\n"
+        )
+    };
+    let corridor = format!(
+        "[image]\nwidth = 3\nheight = 3\n[camera]\nposition = [0, 0, 1]\n[render]\nmax_depth = 10\n\
+         [light]\nposition = [0, 5, 1]\nambient = [1, 1, 1]\ndiffuse = [1, 1, 1]\nspecular = [1, 1, 1]\n{}{}",
+        mirror(-3),
+        mirror(5)
+    );
+    let scene = common::scene(&corridor);
     let (rho, most, segments) = (0.5f64, 1.0f64, 10u32);
     let reach = |k: u32| (0..k).map(|i| rho.powi(i as i32) * most).sum::<f64>();
     let stop_with = |left: &dyn Fn(u32) -> u32| {

@@ -533,8 +533,8 @@ impl Studio {
 
     /// `GET /api/scene[?objects=none]`: the version, the error of the latest
     /// reload (or null), and the last good scene; with `objects=none`, without
-    /// its list of objects (which the page does not read, and which is 27 MB
-    /// of JSON for 100,000 spheres).
+    /// its list of objects (which the page does not read, and which is 24 MB
+    /// of JSON for 100,000 spheres: README, "The studio").
     pub fn scene_json(&self, query: &str) -> Result<Value, Refusal> {
         let (words, taken) = query_words(query, &["objects"])?;
         let listed = match (words.first(), taken[0].as_deref()) {
