@@ -421,6 +421,39 @@ fn the_numbers_the_chapters_quote_are_measured_again() {
     assert_quotes("tutorial-rules", "2,660 pixels by more than 1/255");
 }
 
+/// The appendix's float32 floor point that the tutorial's step leaves inside the
+/// floor: `raystep explain --tutorial --precision f32 --pixel 147,108`, whose
+/// third segment finds one of the floor's roots negative.
+#[test]
+fn the_appendix_shows_a_float32_floor_point_the_step_leaves_inside() {
+    let scene = raystep::io::scene_file::seed();
+    let settings = raystep::render::Settings {
+        precision: raystep::real::Precision::F32,
+        ..raystep::render::Settings::tutorial(raystep::stages::Stages::ALL)
+    };
+    let story = raystep::tools::explain::explain(&scene, &settings, 147, 108).to_string();
+    let third = story.split("segment 2:").nth(1).expect("a third segment");
+    let mut lines = third.lines().skip_while(|l| !l.contains("(the floor)"));
+    let floor = lines.next().expect("the floor's test");
+    let verdict = lines.next().unwrap();
+    let roots = floor.split("roots ").nth(1).unwrap().replace('-', "−");
+    let (near, far) = roots.split_once(", ").unwrap();
+    assert!(near.starts_with('−') && !far.starts_with('−'), "{floor}");
+    let inside = "one root negative, the ray starts inside the sphere";
+    assert!(verdict.contains(inside), "{verdict}");
+    let text = chapter("tutorial-rules");
+    let words = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    for quoted in [
+        "explain --tutorial --precision f32 --pixel 147,108".to_string(),
+        format!("the floor's roots {near} and {far}, \"{inside}\""),
+    ] {
+        assert!(
+            words.contains(&quoted),
+            "the appendix should say {quoted:?}"
+        );
+    }
+}
+
 #[test]
 fn every_accuracy_row_a_chapter_quotes_is_what_raystep_accuracy_prints_now() {
     let rows: Vec<String> = raystep::tools::accuracy::measure_all()
