@@ -101,7 +101,11 @@ fn trace(tracer: &Tracer, primary: Ray, occlusion_on: bool) -> Path {
         let normal = object.normal_at(point, &ray);
         let shifted = shadow::step_off(point, normal, object, tracer.offset);
         let to_light = (tracer.light.position - shifted).normalize();
-        let lit = !tracer.stages.shadow || {
+        let lit = if !tracer.stages.shadow {
+            true
+        } else if shadow::own_shadow(object, normal, to_light, tracer.offset) {
+            false
+        } else {
             let light_distance = tracer.light.position.distance(point);
             !tracer.in_shadow(shifted, to_light, light_distance)
         };
