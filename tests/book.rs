@@ -348,6 +348,42 @@ fn the_numbers_the_chapters_quote_are_measured_again() {
         "04",
         &format!("{turned} of the {shadowed} pixels in\nshadow with the step"),
     );
+    // Chapters 4 and 9, and the README: the defaults against the tutorial's step
+    // alone, and against every tutorial setting (the same pixels: the step is
+    // what changes them).
+    let defaults = "render";
+    for (other, prefix, words) in [
+        (
+            "render --offset fixed:1e-5",
+            "04",
+            "the two pictures differ in",
+        ),
+        (
+            "render --tutorial",
+            "09",
+            "the defaults differ from `--tutorial` in",
+        ),
+    ] {
+        let d = diff(defaults, other);
+        let quoted = format!("{words} {} pixels", d.over_one_step);
+        let text = chapter(prefix)
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        assert!(
+            text.contains(&quoted),
+            "chapter {prefix} should say {quoted:?}"
+        );
+        if prefix == "09" {
+            let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+            let readme = readme.split_whitespace().collect::<Vec<_>>().join(" ");
+            let quoted = format!(
+                "the defaults change {} of the 60,000 pixels by more than one 8-bit step",
+                d.over_one_step
+            );
+            assert!(readme.contains(&quoted), "the README should say {quoted:?}");
+        }
+    }
     // Chapter 5: Blinn-Phong with and without the shadow stage.
     let d = diff(
         "render --stage blinn-phong",
