@@ -731,6 +731,37 @@ mod tests {
         }
     }
 
+    /// Walk the whole tree from the root and check that it reaches every node
+    /// once and each of the `count` objects but those outside the tree once, in
+    /// one leaf (a tree whose links
+    /// were off would skip some and reach others twice, with every box still
+    /// holding what it points to).
+    fn reaches_each_node_and_sphere_once(bvh: &Bvh, count: usize) {
+        let (mut stack, mut nodes, mut spheres) = (vec![0usize], 0, Vec::new());
+        while let Some(i) = stack.pop() {
+            nodes += 1;
+            let n = bvh.nodes[i];
+            if n.count > 0 {
+                spheres
+                    .extend_from_slice(&bvh.items[n.first as usize..(n.first + n.count) as usize]);
+            } else {
+                stack.extend([i + 1, n.first as usize]);
+            }
+        }
+        assert_eq!(nodes, bvh.nodes.len(), "nodes reached from the root");
+        // Every object that is not outside the tree, once.
+        spheres.sort_unstable();
+        let tree: Vec<u32> = (0..count as u32)
+            .filter(|i| !bvh.loose.contains(i))
+            .collect();
+        assert!(
+            spheres == tree,
+            "{} spheres reached of {}",
+            spheres.len(),
+            tree.len()
+        );
+    }
+
     fn grid(count: i32) -> Vec<Object> {
         (0..count)
             .map(|i| {
@@ -748,9 +779,7 @@ mod tests {
     fn every_sphere_sits_in_one_leaf_and_the_depth_fits_the_stack() {
         let objects = grid(1000);
         let bvh = Bvh::build(&objects);
-        let mut seen = bvh.items.clone();
-        seen.sort_unstable();
-        assert_eq!(seen, (0..1000).collect::<Vec<u32>>());
+        reaches_each_node_and_sphere_once(&bvh, 1000);
         // The surface area heuristic keeps an even grid about balanced:
         // log2(1000 / LEAF) + 1 is 9 levels.
         assert!(depth(&bvh, 0) <= 12, "{}", depth(&bvh, 0));
@@ -776,7 +805,7 @@ mod tests {
             let bvh = Bvh::build(&objects);
             let d = depth(&bvh, 0);
             assert!(d < 64, "{d}");
-            assert_eq!(bvh.items.len(), objects.len());
+            reaches_each_node_and_sphere_once(&bvh, objects.len());
         }
     }
 
@@ -793,6 +822,7 @@ mod tests {
         };
         let (one, three) = (build(1), build(3));
         depth(&one, 0);
+        reaches_each_node_and_sphere_once(&one, objects.len());
         let bits = |b: &Bvh| {
             b.nodes
                 .iter()
