@@ -58,3 +58,71 @@ pub fn check_spp(spp: u32) -> Result<(), String> {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The correlation of two equally long series.
+    fn correlation(a: &[f64], b: &[f64]) -> f64 {
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+        let (ma, mb) = (mean(a), mean(b));
+        let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+        let var = |v: &[f64], m: f64| v.iter().map(|x| (x - m) * (x - m)).sum::<f64>();
+        cov / (var(a, ma) * var(b, mb)).sqrt()
+    }
+
+    #[test]
+    fn each_sample_jitters_freely_within_its_own_cell() {
+        // 9 samples in each of 60 × 60 pixels: every sample in its own cell of
+        // the 3 × 3 grid, its jitter (where in the cell) spread evenly over
+        // [0, 1) (mean 1/2, variance 1/12), the row's and the column's jitters
+        // unrelated, and each sample's unrelated to the next one's.
+        let (n, spp) = (3u32, 9u32);
+        let (mut rows, mut cols, mut next_rows) = (Vec::new(), Vec::new(), Vec::new());
+        for row in 0..60 {
+            for col in 0..60 {
+                let jitter = |sample: u32| {
+                    let (y, x) = stratified(row, col, sample, spp);
+                    let cell_y = (y - f64::from(row) + 0.5) * f64::from(n);
+                    let cell_x = (x - f64::from(col) + 0.5) * f64::from(n);
+                    let (jy, jx) = (
+                        cell_y - f64::from(sample / n),
+                        cell_x - f64::from(sample % n),
+                    );
+                    assert!((0.0..1.0).contains(&jy) && (0.0..1.0).contains(&jx));
+                    (jy, jx)
+                };
+                for sample in 0..spp - 1 {
+                    let (jy, jx) = jitter(sample);
+                    rows.push(jy);
+                    cols.push(jx);
+                    next_rows.push(jitter(sample + 1).0);
+                }
+            }
+        }
+        let count = rows.len() as f64;
+        let mean = rows.iter().sum::<f64>() / count;
+        let variance = rows.iter().map(|j| (j - mean) * (j - mean)).sum::<f64>() / count;
+        assert!((mean - 0.5).abs() < 0.01, "mean jitter {mean}");
+        assert!((variance - 1.0 / 12.0).abs() < 0.005, "variance {variance}");
+        for (what, r) in [
+            ("row and column", correlation(&rows, &cols)),
+            ("one sample and the next", correlation(&rows, &next_rows)),
+        ] {
+            assert!(r.abs() < 0.03, "{what}: correlation {r}");
+        }
+    }
+
+    #[test]
+    fn only_square_sample_counts_from_1_to_1024_are_accepted() {
+        for spp in [1, 4, 9, 16, 1024] {
+            assert!(check_spp(spp).is_ok(), "{spp}");
+        }
+        for spp in [0, 2, 5, 8, 1023, 1025] {
+            assert!(check_spp(spp).is_err(), "{spp}");
+        }
+        let said = check_spp(5).unwrap_err();
+        assert!(said.contains("the nearest are 4 and 9"), "{said}");
+    }
+}
