@@ -3,6 +3,8 @@
 //! for the timings of chapters 9 and 10, which depend on the machine, read from
 //! the CSV files `raystep chart` wrote beside the charts it shows.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use raystep::tools::cli::render_command;
@@ -366,17 +368,13 @@ fn the_numbers_the_chapters_quote_are_measured_again() {
     ] {
         let d = diff(defaults, other);
         let quoted = format!("{words} {} pixels", d.over_one_step);
-        let text = chapter(prefix)
-            .split_whitespace()
-            .collect::<Vec<_>>()
-            .join(" ");
+        let text = common::words(&chapter(prefix));
         assert!(
             text.contains(&quoted),
             "chapter {prefix} should say {quoted:?}"
         );
         if prefix == "09" {
-            let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-            let readme = readme.split_whitespace().collect::<Vec<_>>().join(" ");
+            let readme = common::readme_words();
             let quoted = format!(
                 "the defaults change {} of the 60,000 pixels by more than one 8-bit step",
                 d.over_one_step
@@ -477,8 +475,7 @@ fn the_appendix_shows_a_float32_floor_point_the_step_leaves_inside() {
     assert!(near.starts_with('−') && !far.starts_with('−'), "{floor}");
     let inside = "one root negative, the ray starts inside the sphere";
     assert!(verdict.contains(inside), "{verdict}");
-    let text = chapter("tutorial-rules");
-    let words = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let words = common::words(&chapter("tutorial-rules"));
     for quoted in [
         "explain --tutorial --precision f32 --pixel 147,108".to_string(),
         format!("the floor's roots {near} and {far}, \"{inside}\""),

@@ -255,16 +255,10 @@ fn every_bad_scene_file_ends_in_its_message_and_writes_nothing() {
     }
     assert!(paths.len() >= 132, "{} scene files", paths.len());
     let said = format!("`tests/hostile/`: {} scene files", paths.len());
-    assert!(readme().contains(&said), "the README should say {said:?}");
-}
-
-/// The README's words, each run of white space one space.
-fn readme() -> String {
-    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md"));
-    text.unwrap()
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .join(" ")
+    assert!(
+        common::readme_words().contains(&said),
+        "the README should say {said:?}"
+    );
 }
 
 #[test]
@@ -298,7 +292,10 @@ fn every_bad_command_line_ends_in_its_message_and_writes_nothing() {
     }
     assert!(cases.len() >= 78, "{} command cases", cases.len());
     let said = format!("and {} command lines in `commands.toml`", cases.len());
-    assert!(readme().contains(&said), "the README should say {said:?}");
+    assert!(
+        common::readme_words().contains(&said),
+        "the README should say {said:?}"
+    );
     // With the scene files: the 200 inputs of the corpus, at least.
     assert!(cases.len() + scene_files().len() >= 200);
 }

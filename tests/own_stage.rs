@@ -342,13 +342,8 @@ fn the_numbers_chapter_12_quotes() {
     assert_eq!(near, [3]);
     assert!((f64::from(d.largest) - (0.75 * 0.1 + 0.5 * 0.625 * 0.1)).abs() < 1e-6);
 
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/chapters/12-your-own-stage.md"
-    ))
-    .unwrap();
     // The words of the chapter, whatever the line breaks.
-    let text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let text = common::chapter_words("12-your-own-stage.md");
     let percent = 100.0 * d.over_one_step as f64 / d.pixels as f64;
     for quoted in [
         format!(

@@ -144,13 +144,21 @@ pub fn chapter(file: &str) -> String {
         .unwrap_or_else(|e| panic!("chapters/{file}: {e}"))
 }
 
-/// Chapter `file`'s words joined by single spaces: a quote found in it however
-/// the chapter's lines wrap it.
+/// The words of `text` joined by single spaces: a quote found in it however
+/// its lines wrap it.
+pub fn words(text: &str) -> String {
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// Chapter `file`'s [`words`].
 pub fn chapter_words(file: &str) -> String {
-    chapter(file)
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .join(" ")
+    words(&chapter(file))
+}
+
+/// The README's [`words`].
+pub fn readme_words() -> String {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    words(&std::fs::read_to_string(root.join("README.md")).expect("README.md"))
 }
 
 /// What chapter `file` (in `chapters/`) shows after the line `$ COMMAND`, up to
