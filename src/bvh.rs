@@ -856,6 +856,89 @@ mod tests {
     }
 
     #[test]
+    fn the_objects_outside_the_tree_are_tested_too() {
+        // Thirty balls off to the side, in the tree, and the floor (outside it,
+        // the only loose object): a ray straight down from (0, 1, 0) meets only
+        // the floor's top, 1.7 below.
+        let mut objects: Vec<Object> = (0..30)
+            .map(|i| ball(5.0 + f64::from(i % 6), 0.0, -f64::from(i / 6), 0.3))
+            .collect();
+        objects.push(Object {
+            role: Role::Floor,
+            ..ball(0.0, -1000.0, 0.0, 999.3)
+        });
+        let bvh = Bvh::build(&objects);
+        assert_eq!(bvh.loose, vec![30]);
+        let ray = Ray::towards(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, -1.0, 0.0));
+        let hit = bvh.nearest_hit(&objects, &ray, Method::Stable).unwrap();
+        assert_eq!(hit.object, 30);
+        assert!((hit.t - 1.7).abs() < 1e-9, "{}", hit.t);
+        assert!(bvh.blocked(&objects, &ray, 1.8, Method::Stable));
+        assert!(!bvh.blocked(&objects, &ray, 1.6, Method::Stable));
+    }
+
+    #[test]
+    fn a_row_of_64_spheres_along_any_axis_gives_the_balanced_tree_of_full_leaves() {
+        // 64 spheres one apart on a line, listed in a shuffled order (37 is prime
+        // to 64, so sphere i sits at 37·i mod 64). Sixteen bins of 64 centres
+        // hold four each, and the surface area heuristic's cheapest boundary
+        // halves the row at every level: the tree is the perfect one, 16 leaves of
+        // four neighbours (LEAF) and 31 nodes. A split along the wrong axis, by
+        // the list's order, would put strangers in a leaf; leaves of fewer than
+        // LEAF spheres would need more nodes.
+        assert_eq!(LEAF, 4);
+        for axis in 0..3 {
+            let objects: Vec<Object> = (0..64)
+                .map(|i| {
+                    let mut c = [0.0; 3];
+                    c[axis] = f64::from((37 * i) % 64);
+                    ball(c[0], c[1], c[2], 0.3)
+                })
+                .collect();
+            let bvh = Bvh::build(&objects);
+            assert_eq!(bvh.node_count(), 31, "along axis {axis}");
+            assert_eq!(depth(&bvh, 0), 5);
+            reaches_each_node_and_sphere_once(&bvh, 64);
+            for n in bvh.nodes.iter().filter(|n| n.count > 0) {
+                assert_eq!(n.count as usize, LEAF);
+                let mut places: Vec<f64> = bvh.balls
+                    [n.first as usize..(n.first + n.count) as usize]
+                    .iter()
+                    .map(|b| b[axis])
+                    .collect();
+                places.sort_by(f64::total_cmp);
+                assert_eq!(places[0] % 4.0, 0.0, "leaf {places:?} along axis {axis}");
+                assert_eq!(
+                    places[3] - places[0],
+                    3.0,
+                    "leaf {places:?} along axis {axis}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn of_two_equally_cheap_splits_the_lower_boundary_is_taken() {
+        // Three columns of four spheres at x = −10, 0 and 10, mirror images of
+        // each other: "left the first column" and "left the first two" cost
+        // exactly the same (the boxes' areas mirror, bit for bit). `divide` takes
+        // the lowest such boundary, so the root's first child is the first
+        // column alone, a leaf.
+        let objects: Vec<Object> = [-10.0, 0.0, 10.0]
+            .into_iter()
+            .flat_map(|x| (0..4).map(move |y| ball(x, f64::from(y), 0.0, 0.3)))
+            .collect();
+        let bvh = Bvh::build(&objects);
+        let first = bvh.nodes[1];
+        assert_eq!(first.count, 4, "the root's first child");
+        let column: Vec<f64> = bvh.balls[first.first as usize..][..4]
+            .iter()
+            .map(|b| b[0])
+            .collect();
+        assert_eq!(column, [-10.0; 4]);
+    }
+
+    #[test]
     fn the_margin_is_the_rays_own_and_a_far_floor_does_not_widen_it() {
         let spheres: Vec<Object> = (0..100)
             .map(|i| ball(f64::from(i % 10), 0.0, -f64::from(i / 10) - 2.0, 0.01))

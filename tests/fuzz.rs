@@ -79,11 +79,14 @@ fn cases(default: u32) -> u32 {
 }
 
 /// A runner of `cases` cases. Failures are reported with their TOML text rather
-/// than saved to a regressions file.
+/// than saved to a regressions file, after at most two minutes of shrinking (a
+/// change that breaks a property on many scenes could otherwise shrink for more
+/// than ten, rendering each smaller scene, before the test reports it).
 fn runner(cases: u32) -> TestRunner {
     TestRunner::new(Config {
         cases,
         failure_persistence: None,
+        max_shrink_time: 120_000,
         ..Config::default()
     })
 }

@@ -14,9 +14,9 @@ pub const TUTORIAL_STEP: f64 = 1e-5;
 /// the largest coordinate of its centre (or anchor) plus its radius. Kept to be
 /// measured against (`--offset scene`): it is right at every scale, but for a
 /// sphere far from the origin compared with its radius it is a sizeable part of
-/// the radius (8·u·(|C| + r) is half the radius of a sphere of radius 1e-3 at 1000
-/// in float32), and shadow rays that start that far out pass over their own
-/// sphere near the terminator.
+/// the radius (8·u·(max|Cᵢ| + r), with max|Cᵢ| the centre's largest coordinate,
+/// is half the radius of a sphere of radius 1e-3 at 1000 in float32), and shadow
+/// rays that start that far out pass over their own sphere near the terminator.
 pub const SCENE_FACTOR: f64 = 8.0;
 
 /// Unit roundoffs of the radius in the `auto` step over a sphere: the bound
@@ -300,6 +300,56 @@ mod tests {
             normal: up,
         });
         assert!(!own_shadow(&floor, up, below, Offset::Auto));
+    }
+
+    /// A floor through the origin, facing up (its anchor is the origin, so its
+    /// `magnitude` is 0).
+    fn floor() -> Object {
+        let mut floor = crate::bvh::test_ball(0.0, 0.0, 0.0, 1.0);
+        floor.shape = Shape::Plane(crate::plane::Plane {
+            point: crate::Vec3::ZERO,
+            normal: crate::Vec3::Y,
+        });
+        floor
+    }
+
+    #[test]
+    fn the_scene_step_grows_with_the_points_coordinates_where_the_surface_is_small() {
+        // The floor's own numbers are all 0; the point's largest coordinate, 1e3,
+        // sets the step: 8 unit roundoffs of it, ≈ 8.9e-13, straight up.
+        let floor = floor();
+        assert_eq!(floor.magnitude(), 0.0);
+        let point = crate::Vec3::new(1e3, 0.0, -1e3);
+        let moved = step_off(point, crate::Vec3::Y, &floor, Offset::Scene);
+        let expected = SCENE_FACTOR * (f64::EPSILON / 2.0) * 1e3;
+        assert!((8.8e-13..9.0e-13).contains(&expected));
+        assert_eq!(moved, crate::Vec3::new(1e3, expected, -1e3));
+    }
+
+    #[test]
+    fn the_auto_step_over_a_plane_starts_from_the_point_put_back_on_it() {
+        // In float32, far from the anchor: the bound `h` is ~9e-3 there. A point
+        // computed 2h below the floor, or 2h above it, must first go back onto
+        // the floor and then out by h: it ends at height h either way (within
+        // the rounding of the sum), not at -h or 3h as a step from the point as
+        // computed would.
+        let floor = floor().cast::<f32>();
+        type V = <f32 as Real>::Vec3;
+        let on_floor = V::new(1e4, 0.0, 5e3);
+        let u = f32::UNIT_ROUNDOFF;
+        let h = plane_height(on_floor, V::ZERO, u);
+        let size = on_floor.length();
+        assert!((12.0 * u * size..14.0 * u * size).contains(&h));
+        for side in [-2.0f32, 2.0] {
+            let computed = on_floor + V::Y * (side * h);
+            let moved = step_off(computed, V::Y, &floor, Offset::Auto);
+            assert!(
+                (moved.y - h).abs() <= 4.0 * u * size,
+                "from {side}·h: height {} for h = {h}",
+                moved.y
+            );
+            assert_eq!((moved.x, moved.z), (on_floor.x, on_floor.z));
+        }
     }
 
     #[test]
