@@ -1454,7 +1454,7 @@ fn bound(root: &Path) -> Result<String, Error> {
     let labels = [
         (
             "--offset scene",
-            format!("{SCENE_FACTOR}·u·(|C| + r): the size of the scene"),
+            format!("{SCENE_FACTOR}·u·(max|Cᵢ| + r): the size of the scene"),
         ),
         (
             "--offset auto",
