@@ -467,41 +467,56 @@ fn several_samples_average_the_pixel_and_leave_its_buffers_as_one_sample_has_the
     }
 }
 
+/// A rule for ending a path: does it end after segment `s`, given `reach(k)`,
+/// the most `k` segments of weight 1 can add?
+type Ends<'a> = &'a dyn Fn(u32, &dyn Fn(u32) -> f64) -> bool;
+
 /// Early stop ends a path once the most that its remaining segments could add
-/// is under half an 8-bit step. Between two facing mirrors of reflection ρ = ½
-/// the centre ray bounces along the axis, every segment lit; the most that k
-/// segments of weight 1 can add is B·(1 + ρ + … + ρᵏ⁻¹) with B = ka + kd + ks.
-/// The path ends after the first segment s whose weight ρˢ⁺¹ times that for the
-/// segments left falls under the half step: with 10 segments, s = 8 here, one
-/// reflection before the last, where counting one segment too many would give
-/// s = 9.
-#[test]
-fn early_stop_ends_a_path_between_two_mirrors_at_the_segment_its_rule_gives() {
-    // Two mirrors on the camera's axis, in front of it and behind it.
+/// is under half an 8-bit step. Between two facing mirrors of reflection ρ the
+/// centre ray bounces along the axis, every segment lit; the most that k
+/// segments of weight 1 can add is B·(1 + ρ + … + ρᵏ⁻¹) with B = ka + kd + ks
+/// (the light's colours are 1). The path ends after the first segment s whose
+/// weight ρˢ⁺¹ times that for the segments left falls under the half step.
+/// Returns that s for mirrors of `rho` and terms `terms` (ka, kd, ks) with
+/// `segments` segments at most, after checking the render against it: the
+/// centre pixel's bounces and rays, and its colour within an 8-bit level of
+/// the whole path's. `variants` are rules a slip in the code would follow
+/// (the bound computed otherwise); each must give another s, so that the
+/// scene tells them from the rule.
+fn early_stop_between_two_mirrors(
+    rho: f64,
+    terms: [f64; 3],
+    segments: u32,
+    variants: &[(&str, Ends)],
+) -> u32 {
     let mirror = |z: i32| {
         format!(
-            "[[sphere]]\ncenter = [0, 0, {z}]\nradius = 1\nreflection = 0.5\n\
-             ambient = [0.25, 0.25, 0.25]\ndiffuse = [0.5, 0.5, 0.5]\nspecular = [0.25, 0.25, 0.25]\n"
+            "[[sphere]]\ncenter = [0, 0, {z}]\nradius = 1\nreflection = {rho}\n\
+             ambient = [{0}, {0}, {0}]\ndiffuse = [{1}, {1}, {1}]\nspecular = [{2}, {2}, {2}]\n",
+            terms[0], terms[1], terms[2]
         )
     };
     let corridor = format!(
-        "[image]\nwidth = 3\nheight = 3\n[camera]\nposition = [0, 0, 1]\n[render]\nmax_depth = 10\n\
+        "[image]\nwidth = 3\nheight = 3\n[camera]\nposition = [0, 0, 1]\n[render]\nmax_depth = {segments}\n\
          [light]\nposition = [0, 5, 1]\nambient = [1, 1, 1]\ndiffuse = [1, 1, 1]\nspecular = [1, 1, 1]\n{}{}",
         mirror(-3),
         mirror(5)
     );
     let scene = common::scene(&corridor);
-    let (rho, most, segments) = (0.5f64, 1.0f64, 10u32);
+    let most: f64 = terms.iter().sum();
     let reach = |k: u32| (0..k).map(|i| rho.powi(i as i32) * most).sum::<f64>();
-    let stop_with = |left: &dyn Fn(u32) -> u32| {
-        (0..segments)
-            .find(|&s| rho.powi(s as i32 + 1) * reach(left(s)) < raystep::render::HALF_STEP)
-            .unwrap()
-    };
-    let stop = stop_with(&|s| segments - s - 1);
-    assert_eq!(stop, 8);
-    // The scene tells the count apart: one segment too many gives another s.
-    assert_ne!(stop_with(&|s| segments - s), stop);
+    // The first s at which `ends(s, reach)` holds.
+    let stop_with = |ends: Ends| (0..segments).find(|&s| ends(s, &reach)).unwrap();
+    let stop = stop_with(&|s, reach| {
+        rho.powi(s as i32 + 1) * reach(segments - s - 1) < raystep::render::HALF_STEP
+    });
+    for (what, variant) in variants {
+        assert_ne!(
+            stop_with(variant),
+            stop,
+            "{what} gives the rule's stop here"
+        );
+    }
 
     let render = |early_stop: bool| {
         let settings = Settings {
@@ -522,6 +537,57 @@ fn early_stop_ends_a_path_between_two_mirrors_at_the_segment_its_rule_gives() {
     for k in 0..3 {
         assert!((stopped.colour[k] - whole.colour[k]).abs() < 1.0 / 255.0);
     }
+    stop
+}
+
+/// With ρ = ½ and B = 1 over 10 segments the path ends at s = 8, one
+/// reflection before the last, where counting one segment too many would give
+/// s = 9.
+#[test]
+fn early_stop_ends_a_path_between_two_mirrors_at_the_segment_its_rule_gives() {
+    let one_too_many = |s: u32, reach: &dyn Fn(u32) -> f64| {
+        0.5f64.powi(s as i32 + 1) * reach(10 - s) < raystep::render::HALF_STEP
+    };
+    let stop = early_stop_between_two_mirrors(
+        0.5,
+        [0.25, 0.5, 0.25],
+        10,
+        &[("one segment too many", &one_too_many)],
+    );
+    assert_eq!(stop, 8);
+}
+
+/// With ρ = 0.2 and B = 0.1 + 0.5 + 0.4 = 1 over 12 segments, reach(k) =
+/// 1.25·(1 − 0.2ᵏ): after segment 3 what is left is 0.2⁴·1.25 = 0.0020, just
+/// over the half step 0.00196, and after segment 4 it is 0.0004, so the path
+/// ends at s = 4. The scene tells the bound's parts apart: a half step a fifth
+/// larger, or the specular term left out of B (0.6·1.25·0.0016 = 0.0012), would
+/// stop it at 3; the segments left counted without ρ (B·k) at 5.
+#[test]
+fn early_stop_weighs_every_term_and_the_mirrors_reflection() {
+    let (rho, segments) = (0.2f64, 12u32);
+    let weight = |s: u32| rho.powi(s as i32 + 1);
+    let left = |s: u32| segments - s - 1;
+    let larger_step = |s: u32, reach: &dyn Fn(u32) -> f64| {
+        weight(s) * reach(left(s)) < 1.2 * raystep::render::HALF_STEP
+    };
+    let no_specular = |s: u32, reach: &dyn Fn(u32) -> f64| {
+        weight(s) * reach(left(s)) * 0.6 < raystep::render::HALF_STEP
+    };
+    let no_reflection = |s: u32, _: &dyn Fn(u32) -> f64| {
+        weight(s) * f64::from(left(s)) < raystep::render::HALF_STEP
+    };
+    let stop = early_stop_between_two_mirrors(
+        rho,
+        [0.1, 0.5, 0.4],
+        segments,
+        &[
+            ("a half step a fifth larger", &larger_step),
+            ("B without ks", &no_specular),
+            ("the segments left without ρ", &no_reflection),
+        ],
+    );
+    assert_eq!(stop, 4);
 }
 
 /// The BVH only skips tests whose answer it knows: with it and without it the
