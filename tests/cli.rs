@@ -631,7 +631,40 @@ fn json_outputs_carry_schema_1_and_the_documented_fields() {
         assert!(render["seconds"][key].as_f64().unwrap() >= 0.0, "{render}");
     }
     assert_eq!(render["rays"]["primary"].as_u64(), Some(24 * 16));
-    assert!(render["rays"]["total"].as_u64().unwrap() >= 24 * 16);
+    // Each count is the one `bench` reports for the same frame (its engine
+    // traces the same rays), and the total is their sum.
+    let counted = json(&[
+        "bench",
+        "--width",
+        "24",
+        "--height",
+        "16",
+        "--runs",
+        "1",
+        "--no-yardstick",
+        "--json",
+    ]);
+    let rays = &render["rays"];
+    for (key, bench_key) in [
+        ("primary", "rays_primary"),
+        ("shadow", "rays_shadow"),
+        ("reflection", "rays_reflection"),
+        ("total", "rays"),
+    ] {
+        assert_eq!(
+            rays[key], counted[bench_key],
+            "{key}: {rays} against {counted}"
+        );
+    }
+    let sum: u64 = ["primary", "shadow", "reflection"]
+        .iter()
+        .map(|k| rays[k].as_u64().unwrap())
+        .sum();
+    assert_eq!(rays["total"].as_u64(), Some(sum));
+    assert!(
+        rays["shadow"].as_u64() > rays["reflection"].as_u64(),
+        "{rays}"
+    );
 
     let check = json(&["check", seed, "--json"]);
     has(
@@ -663,6 +696,31 @@ fn json_outputs_carry_schema_1_and_the_documented_fields() {
     );
     assert_eq!(diff["different"], false);
     assert_eq!(diff["pixels"].as_u64(), Some(24 * 16));
+    // A picture differs from itself by more than 0 nowhere: threshold 0 too.
+    let exact = json(&[
+        "diff",
+        "r/buffers.exr",
+        "r/buffers.exr",
+        "--threshold",
+        "0",
+        "--json",
+    ]);
+    assert_eq!(exact["over_threshold"].as_u64(), Some(0), "{exact}");
+    assert_eq!(exact["different"], false);
+    // `clipped` counts a's clipped pixels, then b's: the rays stage's colours,
+    // (d + 1)/2 for a unit direction d, never reach 1.
+    let rays_only = json(&[
+        "render", "--width", "24", "--height", "16", "-o", "d", "--stage", "rays", "--json",
+    ]);
+    assert_eq!(rays_only["schema"], 1);
+    let clipped = |a: &str, b: &str| {
+        let diff = json(&["diff", a, b, "--json"]);
+        let c = diff["clipped"].as_array().unwrap().clone();
+        (c[0].as_u64().unwrap(), c[1].as_u64().unwrap())
+    };
+    let (lit, none) = clipped("r/buffers.exr", "d/buffers.exr");
+    assert!(lit > 0 && none == 0, "clipped {lit}, {none}");
+    assert_eq!(clipped("d/buffers.exr", "r/buffers.exr"), (0, lit));
 
     let explain = json(&["explain", "--pixel", "1,1", "--json"]);
     has(&explain, &["depth"]);
@@ -993,4 +1051,41 @@ fn status_lines_and_refusals_say_what_they_mean() {
         "{}",
         text(&out.stderr)
     );
+}
+
+#[test]
+fn each_exr_compression_writes_the_scheme_openexr_names() {
+    // OpenEXR's schemes, and the scan lines each packs into one block: none,
+    // RLE and ZIPS one, ZIP 16, PIZ 32. Every lossless scheme reads back the
+    // same samples, so only the file's header tells them apart.
+    use exr::compression::Compression;
+    let dir = tempfile::tempdir().unwrap();
+    for (name, scheme, lines) in [
+        ("none", Compression::Uncompressed, 1),
+        ("rle", Compression::RLE, 1),
+        ("zips", Compression::ZIP1, 1),
+        ("zip", Compression::ZIP16, 16),
+        ("piz", Compression::PIZ, 32),
+    ] {
+        let args = [
+            "render",
+            "--width",
+            "24",
+            "--height",
+            "40",
+            "--exr-compression",
+            name,
+            "-o",
+            name,
+            "-q",
+        ];
+        let out = raystep(dir.path(), &args);
+        assert!(out.status.success(), "{name}: {}", text(&out.stderr));
+        let path = dir.path().join(name).join("buffers.exr");
+        let meta = exr::meta::MetaData::read_from_file(&path, false).unwrap();
+        let header = &meta.headers[0];
+        assert_eq!(header.compression, scheme, "--exr-compression {name}");
+        assert_eq!(header.compression.scan_lines_per_block(), lines);
+        assert_eq!(header.chunk_count, 40usize.div_ceil(lines), "{name}");
+    }
 }

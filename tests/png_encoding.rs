@@ -132,7 +132,16 @@ fn png_srgb_writes_a_brighter_beauty_png_that_is_the_transfer_of_the_exr() {
     assert!(brighter > 60 * 40, "{brighter} channels brighter");
 
     // The pictures that hold no light are the same; the terms are encoded too.
-    for name in ["depth", "normal", "shadow", "object", "bounces", "rays"] {
+    for name in [
+        "depth",
+        "normal",
+        "shadow",
+        "object",
+        "bounces",
+        "rays",
+        "direction",
+        "position",
+    ] {
         let file = format!("{name}.png");
         assert_eq!(
             std::fs::read(linear.join(&file)).unwrap(),
@@ -140,9 +149,16 @@ fn png_srgb_writes_a_brighter_beauty_png_that_is_the_transfer_of_the_exr() {
             "{file}"
         );
     }
+    // The terms go through the curve as the beauty does: it lies above the
+    // identity on (0, 1), so no byte is darker and the lit values come out
+    // brighter.
     for name in ["ambient", "diffuse", "specular"] {
         let file = format!("{name}.png");
         let bytes = std::fs::read(srgb.join(&file)).unwrap();
         assert!(chunks(&bytes).contains(&"sRGB".to_string()), "{file}");
+        let (l, s) = (rgb(&linear.join(&file)), rgb(&srgb.join(&file)));
+        assert!(l.iter().zip(&s).all(|(l, s)| s >= l), "{file}");
+        let brighter = l.iter().zip(&s).filter(|(l, s)| s > l).count();
+        assert!(brighter > 100, "{file}: {brighter} channels brighter");
     }
 }
