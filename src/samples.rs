@@ -63,9 +63,13 @@ pub fn check_spp(spp: u32) -> Result<(), String> {
 mod tests {
     use super::*;
 
+    /// The mean of a series.
+    fn mean(v: &[f64]) -> f64 {
+        v.iter().sum::<f64>() / v.len() as f64
+    }
+
     /// The correlation of two equally long series.
     fn correlation(a: &[f64], b: &[f64]) -> f64 {
-        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
         let (ma, mb) = (mean(a), mean(b));
         let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
         let var = |v: &[f64], m: f64| v.iter().map(|x| (x - m) * (x - m)).sum::<f64>();
@@ -101,9 +105,9 @@ mod tests {
                 }
             }
         }
-        let count = rows.len() as f64;
-        let mean = rows.iter().sum::<f64>() / count;
-        let variance = rows.iter().map(|j| (j - mean) * (j - mean)).sum::<f64>() / count;
+        let mean = mean(&rows);
+        let variance =
+            rows.iter().map(|j| (j - mean) * (j - mean)).sum::<f64>() / rows.len() as f64;
         assert!((mean - 0.5).abs() < 0.01, "mean jitter {mean}");
         assert!((variance - 1.0 / 12.0).abs() < 0.005, "variance {variance}");
         for (what, r) in [

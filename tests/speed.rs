@@ -123,12 +123,13 @@ fn every_object_a_primary_ray_hits_is_in_its_tiles_mask() {
     // tiny-far's sphere fills its picture; on a screen 30 times as wide and high
     // it is a dot of a few pixels, and float32's false hits fall on every tile.
     let mut list = scenes();
+    let wide_name = "tiny-far on a wide screen";
     let mut wide = load("scenes/stress/tiny-far.toml", 96, 64);
     let s = wide.screen.as_mut().unwrap();
     let (x, y) = ((s.left + s.right) / 2.0, (s.top + s.bottom) / 2.0);
     let (w, h) = (15.0 * (s.right - s.left), 15.0 * (s.bottom - s.top));
     (s.left, s.right, s.top, s.bottom) = (x - w, x + w, y - h, y + h);
-    list.push(("tiny-far on a wide screen".into(), wide));
+    list.push((wide_name.into(), wide));
     // Pixels of it that float32's textbook quadratic hits and float64's stable
     // test misses: false hits, outside the outline.
     let mut outside_outline = 0;
@@ -167,7 +168,7 @@ fn every_object_a_primary_ray_hits_is_in_its_tiles_mask() {
                     if (precision, method, spp) == (Precision::F64, Method::Stable, 1) {
                         exact_misses = misses.collect();
                     } else if (precision, method, spp) == (Precision::F32, Method::Naive, 1)
-                        && name == "tiny-far on a wide screen"
+                        && name == wide_name
                     {
                         outside_outline += misses
                             .zip(&exact_misses)
@@ -180,7 +181,7 @@ fn every_object_a_primary_ray_hits_is_in_its_tiles_mask() {
     }
     assert!(
         outside_outline > 96 * 64 / 4,
-        "{outside_outline} false hits in tiny-far on a wide screen"
+        "{outside_outline} false hits in {wide_name}"
     );
 }
 

@@ -294,12 +294,7 @@ mod tests {
         assert!(!own_shadow(&ball, up, below, Offset::TUTORIAL));
         assert!(!own_shadow(&ball, up, below, Offset::Scene));
         // A plane lights both of its faces.
-        let mut floor = ball;
-        floor.shape = Shape::Plane(crate::plane::Plane {
-            point: crate::Vec3::ZERO,
-            normal: up,
-        });
-        assert!(!own_shadow(&floor, up, below, Offset::Auto));
+        assert!(!own_shadow(&floor(), up, below, Offset::Auto));
     }
 
     /// A floor through the origin, facing up (its anchor is the origin, so its
@@ -321,7 +316,7 @@ mod tests {
         assert_eq!(floor.magnitude(), 0.0);
         let point = crate::Vec3::new(1e3, 0.0, -1e3);
         let moved = step_off(point, crate::Vec3::Y, &floor, Offset::Scene);
-        let expected = SCENE_FACTOR * (f64::EPSILON / 2.0) * 1e3;
+        let expected = SCENE_FACTOR * f64::UNIT_ROUNDOFF * 1e3;
         assert!((8.8e-13..9.0e-13).contains(&expected));
         assert_eq!(moved, crate::Vec3::new(1e3, expected, -1e3));
     }
