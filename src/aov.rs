@@ -436,3 +436,38 @@ impl Frame {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{FirstHit, PixelRecord, NO_OBJECT};
+    use crate::Vec3;
+
+    fn hit_at(depth: f64) -> FirstHit {
+        FirstHit {
+            depth,
+            normal: Vec3::Y,
+            lit: false,
+            object: 2,
+            diffuse: 0.0,
+            specular: 0.0,
+        }
+    }
+
+    /// A hit farther than float32 reaches (a plane met almost edge-on, 1e39
+    /// along the ray) is kept as a hit at the largest float32, never the +∞
+    /// that marks a miss; a miss stays +∞.
+    #[test]
+    fn a_hit_beyond_float32s_range_is_still_a_hit() {
+        for depth in [1e39, 1e300, f64::from(f32::MAX) * 2.0] {
+            let record = PixelRecord::new(Vec3::ZERO, Some(hit_at(depth)), 0, 2);
+            assert_eq!(record.depth, f32::MAX, "{depth:e}");
+            assert!(record.is_hit(), "{depth:e}");
+            assert_eq!((record.shadow, record.object), (0.0, 2), "{depth:e}");
+        }
+        let near = PixelRecord::new(Vec3::ZERO, Some(hit_at(1.5)), 0, 2);
+        assert_eq!(near.depth, 1.5);
+        let missed = PixelRecord::new(Vec3::ZERO, None, 0, 1);
+        assert_eq!((missed.depth, missed.object), (f32::INFINITY, NO_OBJECT));
+        assert!(!missed.is_hit());
+    }
+}

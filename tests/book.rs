@@ -382,6 +382,58 @@ fn the_numbers_the_chapters_quote_are_measured_again() {
             assert!(readme.contains(&quoted), "the README should say {quoted:?}");
         }
     }
+    // Chapter 4's account of those pixels: in some the shadow mask differs; the
+    // rest are lit in both pictures, and there the reflected rays take another
+    // path (the `rays` buffer differs). Objects 0 and 3 of the seed scene are
+    // the red sphere and the floor.
+    let auto = render_command(defaults, &root()).unwrap();
+    let fixed = render_command("render --offset fixed:1e-5", &root()).unwrap();
+    let differing: Vec<_> = (auto.pixels.iter().zip(&fixed.pixels))
+        .filter(|(a, b)| (0..3).any(|c| (a.colour[c] - b.colour[c]).abs() > 1.0 / 255.0))
+        .collect();
+    assert_eq!(
+        differing.len(),
+        diff(defaults, "render --offset fixed:1e-5").over_one_step
+    );
+    let (masked, lit): (Vec<_>, Vec<_>) = differing.iter().partition(|(a, b)| a.shadow != b.shadow);
+    for (a, b) in &lit {
+        assert_eq!((a.shadow, b.shadow), (1.0, 1.0), "{a:?} {b:?}");
+        assert_ne!(a.rays, b.rays, "{a:?} {b:?}");
+    }
+    let on = |object: u32| lit.iter().filter(|(a, _)| a.object == object).count();
+    assert_eq!(on(0) + on(3), lit.len());
+    let quoted = format!(
+        "In {} of them, along the edges of the dark sides, the shadow mask differs; the \
+         other {}, {} on the floor and {} on the red sphere, are lit in both",
+        masked.len(),
+        lit.len(),
+        on(3),
+        on(0)
+    );
+    assert!(
+        common::words(&chapter("04")).contains(&quoted),
+        "chapter 4 should say {quoted:?}"
+    );
+    // Chapter 9: `--tutorial` changes the same pixels as its step alone.
+    let tutorial = render_command("render --tutorial", &root()).unwrap();
+    let places = |other: &raystep::aov::Frame| -> Vec<usize> {
+        (auto.pixels.iter().zip(&other.pixels).enumerate())
+            .filter(|(_, (a, b))| (0..3).any(|c| (a.colour[c] - b.colour[c]).abs() > 1.0 / 255.0))
+            .map(|(i, _)| i)
+            .collect()
+    };
+    assert_eq!(places(&tutorial), places(&fixed));
+    let quoted = format!(
+        "{} along the edges of the dark sides, which the 1e-5 step wrongly lit, and {} lit \
+         in both whose reflected rays take another path (the same {} pixels as",
+        masked.len(),
+        lit.len(),
+        differing.len()
+    );
+    assert!(
+        common::words(&chapter("09")).contains(&quoted),
+        "chapter 9 should say {quoted:?}"
+    );
     // Chapter 5: Blinn-Phong with and without the shadow stage.
     let d = diff(
         "render --stage blinn-phong",

@@ -543,6 +543,49 @@ fn diff_exits_0_same_1_different_2_trouble_with_a_threshold() {
     assert_eq!(code(&["diff", "a/buffers.exr"]), Some(2));
 }
 
+/// `diff` says where the largest difference lies as row, then column, in its
+/// text and in `--json`: two 30 × 20 pictures (30 columns, 20 rows) that differ
+/// in one pixel, row 5, column 17, by 0.5 in green, and by 0.1 in row 12,
+/// column 3. A place given as (column, row) would be off the picture.
+#[test]
+fn diff_places_the_largest_difference_at_its_row_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let (width, height) = (30, 20);
+    let write = |name: &str, changed: bool| {
+        exr::prelude::write_rgb_file(dir.path().join(name), width, height, |col, row| {
+            let green = match (changed, row, col) {
+                (true, 5, 17) => 0.75,
+                (true, 12, 3) => 0.35,
+                _ => 0.25f32,
+            };
+            (0.5f32, green, 0.125f32)
+        })
+        .unwrap();
+    };
+    write("a.exr", false);
+    write("b.exr", true);
+    for (a, b) in [("a.exr", "b.exr"), ("b.exr", "a.exr")] {
+        let json = raystep(dir.path(), &["diff", a, b, "--json"]);
+        assert_eq!(json.status.code(), Some(1), "{}", text(&json.stderr));
+        let report: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+        assert_eq!(report["width"], width, "{report}");
+        assert_eq!(report["height"], height, "{report}");
+        assert_eq!(report["largest"], 0.5, "{report}");
+        assert_eq!(
+            report["largest_at"],
+            serde_json::json!({ "row": 5, "column": 17 }),
+            "{report}"
+        );
+        assert_eq!(report["over_one_step"], 2, "{report}");
+        let said = raystep(dir.path(), &["diff", a, b]);
+        assert!(
+            text(&said.stdout).contains("largest difference:        0.5000 (row 5, column 17)"),
+            "{}",
+            text(&said.stdout)
+        );
+    }
+}
+
 /// Issue 22's bound: a 1920 × 1080 render with every buffer (twelve pictures
 /// and the EXR of 26 channels) peaks at or under 150 MB (10⁶ bytes), as
 /// `render --json` reports it from `/proc` (125.8 MB with a release build on
