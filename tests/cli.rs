@@ -220,6 +220,96 @@ fn check_counts_the_spheres_past_the_first_twenty() {
     assert_eq!(v["objects"].as_array().unwrap().len(), 31);
 }
 
+/// `check --json` of `scenes/seed.toml`, value for value against the file's own
+/// numbers: the image, the camera, the default screen (x from -1 to 1, y ±200/300),
+/// the counts, and the first, second and last objects with the defaults the file
+/// leaves out (specular 1, shininess 100, reflection 0.5).
+#[test]
+fn check_json_states_the_seed_scenes_numbers() {
+    use serde_json::json;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = raystep(root, &["check", "scenes/seed.toml", "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["scene"], "scenes/seed.toml", "the path as given");
+    for (key, expected) in [
+        ("width", json!(300)),
+        ("height", json!(200)),
+        ("max_depth", json!(3)),
+        ("camera", json!([0.0, 0.0, 1.0])),
+        ("spheres", json!(3)),
+        ("planes", json!(1)),
+        ("object_count", json!(4)),
+    ] {
+        assert_eq!(v[key], expected, "{key}");
+    }
+    let screen = &v["screen"];
+    assert_eq!(screen["from_scene"], false, "{screen}");
+    for (key, expected) in [("left", -1.0), ("right", 1.0), ("top", 2.0 / 3.0)] {
+        let got = screen[key].as_f64().unwrap();
+        assert!((got - expected).abs() < 1e-12, "{key}: {got}");
+    }
+    assert_eq!(
+        screen["bottom"].as_f64(),
+        Some(-screen["top"].as_f64().unwrap())
+    );
+    let red = &v["objects"][0];
+    assert_eq!(red["entry"], "sphere", "{red}");
+    assert_eq!(red["shape"], "sphere", "{red}");
+    assert_eq!(red["center"], json!([-0.2, 0.0, -1.0]), "{red}");
+    assert_eq!(red["radius"], 0.7, "{red}");
+    let material = json!({
+        "ambient": [0.1, 0.0, 0.0],
+        "diffuse": [0.7, 0.0, 0.0],
+        "specular": [1.0, 1.0, 1.0],
+        "shininess": 100.0,
+        "reflection": 0.5,
+    });
+    assert_eq!(red["material"], material, "{red}");
+    assert_eq!(v["objects"][1]["radius"], 0.1, "the magenta sphere");
+    // The floor is a [[plane]] entry made of a sphere.
+    let floor = &v["objects"][3];
+    assert_eq!(floor["entry"], "plane", "{floor}");
+    assert_eq!(floor["shape"], "sphere", "{floor}");
+    assert_eq!(floor["center"], json!([0.0, -9000.0, 0.0]), "{floor}");
+    assert_eq!(floor["radius"], 8999.3, "{floor}");
+}
+
+/// `check --json` of a scene on stdin that sets what seed.toml leaves to the
+/// defaults: the light's three colours (each different), a light off the
+/// diagonal, a screen of its own, and a true plane.
+#[test]
+fn check_json_states_the_light_the_screen_and_a_true_plane() {
+    use serde_json::json;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = b"[camera]\nposition = [0, 0, 2]\n\
+        [screen]\nleft = -0.5\nright = 0.5\ntop = 0.25\nbottom = -0.125\n\
+        [light]\nposition = [1, 2, 3]\nambient = [0.1, 0.2, 0.3]\n\
+        diffuse = [0.4, 0.5, 0.6]\nspecular = [0.7, 0.8, 0.9]\n\
+        [[plane]]\npoint = [0, -1, 0]\nnormal = [0, 1, 0]\n";
+    let out = raystep_with_input(dir.path(), &["check", "-", "--json"], scene);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["scene"], "<stdin>");
+    let light = json!({
+        "position": [1.0, 2.0, 3.0],
+        "ambient": [0.1, 0.2, 0.3],
+        "diffuse": [0.4, 0.5, 0.6],
+        "specular": [0.7, 0.8, 0.9],
+    });
+    assert_eq!(v["light"], light);
+    let screen = json!({
+        "left": -0.5, "right": 0.5, "top": 0.25, "bottom": -0.125, "from_scene": true,
+    });
+    assert_eq!(v["screen"], screen);
+    assert_eq!((&v["spheres"], &v["planes"]), (&json!(0), &json!(1)));
+    let plane = &v["objects"][0];
+    assert_eq!(plane["entry"], "plane", "{plane}");
+    assert_eq!(plane["shape"], "plane", "{plane}");
+    assert_eq!(plane["point"], json!([0.0, -1.0, 0.0]), "{plane}");
+    assert_eq!(plane["normal"], json!([0.0, 1.0, 0.0]), "{plane}");
+}
+
 #[test]
 fn help_and_version_work() {
     let dir = tempfile::tempdir().unwrap();
