@@ -72,7 +72,7 @@ use crate::stages::Stage;
 use crate::Vec3;
 
 // A packet's pixels must share a tile, so that they share its mask.
-const _: () = assert!(TILE.0 as usize % WIDTH == 0);
+const _: () = assert!((TILE.0 as usize).is_multiple_of(WIDTH));
 
 /// The most objects the packet tracer takes (one bit each in a search mask).
 pub const MAX_OBJECTS: usize = 64;
@@ -601,7 +601,7 @@ impl<T: Laned> Fast<T> {
         assert!((1..=WIDTH).contains(&n), "a packet has 1 to {WIDTH} pixels");
         // The four pixels share the tile mask of the first, and the objects in lanes.
         debug_assert!(
-            col as usize % WIDTH == 0,
+            (col as usize).is_multiple_of(WIDTH),
             "a packet starts at a multiple of {WIDTH}"
         );
         debug_assert!(self.packets, "a fast engine made without packets");

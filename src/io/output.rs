@@ -798,7 +798,7 @@ fn unit_vector_colour(v: [f32; 3]) -> [f32; 3] {
 }
 
 fn miss_colour(row: u32, col: u32) -> [f32; 3] {
-    if (row / 4 + col / 4) % 2 == 0 {
+    if (row / 4 + col / 4).is_multiple_of(2) {
         [0.10, 0.12, 0.30]
     } else {
         [0.18, 0.22, 0.45]

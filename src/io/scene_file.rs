@@ -1431,10 +1431,10 @@ mod tests {
             3 + i % 5,
             1 + i % 9
         );
-        if i % 2 == 0 {
+        if i.is_multiple_of(2) {
             s += &format!("ambient = [0.0{}, 0.1, 0.2]\n", i % 10);
         }
-        if i % 3 == 0 {
+        if i.is_multiple_of(3) {
             s += "reflection = 0.25 # a comment\n";
         }
         s
@@ -1732,5 +1732,261 @@ mod tests {
                 "{v} shown as {shown}"
             );
         }
+    }
+
+    /// The smallest scene: a camera and a light, no objects.
+    const SMALL: &str = "[camera]\nposition = [0, 0, 1]\n[light]\nposition = [5, 5, 5]\n";
+
+    /// [`SMALL`] with `extra` after it, read whole.
+    fn small(extra: &str) -> Result<Scene, String> {
+        whole(&format!("{SMALL}{extra}"))
+    }
+
+    /// A sphere of radius 1 at [0, 0, -3] with the material keys `keys`.
+    fn sphere_with(keys: &str) -> String {
+        format!("[[sphere]]\ncenter = [0, 0, -3]\nradius = 1\n{keys}")
+    }
+
+    #[test]
+    fn the_largest_image_and_max_depth_are_accepted_and_one_more_is_refused() {
+        let eight_k = small("[image]\nwidth = 7680\nheight = 4320\n").unwrap();
+        assert_eq!((eight_k.width, eight_k.height), (7680, 4320));
+        assert_eq!(
+            small("[image]\nwidth = 7680\nheight = 4321\n"),
+            Err(
+                "image.width = 7680 and image.height = 4321 make 33185280 pixels; raystep \
+                 renders at most 33177600 (7680 × 4320), since a render needs about 64 bytes \
+                 per pixel and this one would need 2.1 GB"
+                    .into()
+            )
+        );
+        assert_eq!(small("[render]\nmax_depth = 64\n").unwrap().max_depth, 64);
+        assert_eq!(
+            small("[render]\nmax_depth = 65\n"),
+            Err("render.max_depth = 65: must be from 1 to 64".into())
+        );
+    }
+
+    #[test]
+    fn the_least_camera_distance_and_radius_are_accepted_and_less_is_refused() {
+        // The default screen's edges are at most 1 from its centre, and 1.9e-15
+        // of 1 is below 1e-12: the least distance from the screen is 1e-12.
+        let camera = |z: &str| whole(&SMALL.replace("[0, 0, 1]", &format!("[0, 0, {z}]")));
+        assert_eq!(camera("1e-12").unwrap().camera.z, 1e-12);
+        assert_eq!(
+            camera("-9.99e-13"),
+            Err(
+                "camera.position: z = -9.99e-13 puts the eye too near the screen, which lies \
+                 in the plane z = 0: it must be at least 1e-12 away (1.86265e-15 × 1, the \
+                 largest coordinate of the screen's edges and the camera's x and y, and at \
+                 least 1e-12), or rays to the screen have no direction; e.g. position = \
+                 [0, 0, 1]"
+                    .into()
+            )
+        );
+        // The same least length for a sphere's radius: 1e-12 is accepted.
+        let radius = |r: &str| small(&format!("[[sphere]]\ncenter = [0, 0, -1]\nradius = {r}\n"));
+        let Shape::Sphere(s) = radius("1e-12").unwrap().objects[0].shape else {
+            panic!("a sphere");
+        };
+        assert_eq!(s.radius, 1e-12);
+        assert_eq!(
+            radius("9.99e-13"),
+            Err(
+                "[[sphere]] number 1, radius: 9.99e-13 is smaller than 1e-12, the least \
+                 raystep accepts here in float64 (1.86265e-15 × 1, the largest coordinate of \
+                 its center and of the camera, and at least 1e-12): float64 would round its \
+                 hit points by a sizeable part of its size; make it larger or scale the whole \
+                 scene"
+                    .into()
+            )
+        );
+    }
+
+    #[test]
+    fn float32_takes_a_camera_at_its_least_distance_and_refuses_one_nearer() {
+        let camera = |z: &str| whole(&SMALL.replace("[0, 0, 1]", &format!("[0, 0, {z}]")));
+        let at_least = camera("1e-6").unwrap();
+        assert_eq!(check_precision(&at_least, Precision::F32), Ok(vec![]));
+        assert_eq!(
+            check_precision(&camera("9.99e-7").unwrap(), Precision::F32),
+            Err(
+                "camera.position: z = 9.99e-7 puts the eye too near the screen for float32 \
+                 (at least 1e-6 × 1); float64 (the default precision, --precision f64) \
+                 renders it"
+                    .into()
+            )
+        );
+    }
+
+    #[test]
+    fn a_material_at_the_ends_of_its_ranges_is_accepted_and_past_them_refused() {
+        let scene = small(&sphere_with(
+            "ambient = [0, 0, 0]\nshininess = 0\nreflection = 1\n",
+        ))
+        .unwrap();
+        let m = &scene.objects[0].material;
+        assert_eq!(
+            (m.ambient, m.shininess, m.reflection),
+            (Vec3::ZERO, 0.0, 1.0)
+        );
+        let matte = small(&sphere_with("reflection = 0\nshininess = 1e15\n")).unwrap();
+        let m = &matte.objects[0].material;
+        assert_eq!((m.reflection, m.shininess), (0.0, 1e15));
+        assert_eq!(
+            small(&sphere_with("reflection = 1.0000000000000002\n")),
+            Err(
+                "[[sphere]] number 1, reflection: 1.0000000000000002 must be from 0 (matte) \
+                 to 1 (perfect mirror)"
+                    .into()
+            )
+        );
+        assert_eq!(
+            small(&sphere_with("shininess = 1000000000000001.0\n")),
+            Err(
+                "[[sphere]] number 1, shininess: 1000000000000001 is larger than 1e15 \
+                 in magnitude, the most raystep accepts"
+                    .into()
+            )
+        );
+    }
+
+    #[test]
+    fn a_light_on_a_sphere_within_the_band_is_refused_and_just_past_it_accepted() {
+        // A sphere larger than the scene's coordinates (the camera's largest is
+        // 0.75): the band is 1.9e-15 of its radius, 1.
+        let edge = 1.0 + MIN_RADIUS_RATIO_F64;
+        let light = |x: f64| {
+            whole(&format!(
+                "[camera]\nposition = [0.5, 0.5, 0.75]\n[light]\nposition = [{x:?}, 0, 0]\n\
+                 [[sphere]]\ncenter = [0, 0, 0]\nradius = 1\n"
+            ))
+        };
+        assert_eq!(
+            light(edge),
+            Err(format!(
+                "light.position [{edge}, 0, 0] is inside [[sphere]] number 1 (center [0, 0, 0], \
+                 radius 1): no light could leave it, so every other point would be in shadow; \
+                 move the light or the sphere"
+            ))
+        );
+        assert!(light(edge.next_up()).is_ok());
+    }
+
+    #[test]
+    fn a_light_at_the_origin_on_a_plane_through_it_is_refused() {
+        let text = SMALL.replace("[5, 5, 5]", "[0, 0, 0]")
+            + "[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\n";
+        assert_eq!(
+            whole(&text),
+            Err(
+                "light.position [0, 0, 0] lies on [[plane]] number 1: the plane would be lit \
+                 edge-on, and the light would be a point of it; move the light off the plane"
+                    .into()
+            )
+        );
+    }
+
+    #[test]
+    fn a_recipe_without_a_seed_is_seed_1() {
+        let recipe = |seed: &str| small(&format!("[generate]\nspheres = 3\n{seed}"));
+        let default = recipe("").unwrap();
+        assert_eq!(default.objects.len(), 3);
+        assert_eq!(Ok(&default), recipe("seed = 1\n").as_ref());
+        assert_ne!(Ok(&default), recipe("seed = 0\n").as_ref());
+    }
+
+    #[test]
+    fn a_key_is_suggested_up_to_a_third_of_its_length_in_edits() {
+        let sphere = &SECTIONS[5].1;
+        assert_eq!(SECTIONS[5].0, "[[sphere]]");
+        // `reflection`: 10 letters, 3 edits; `position`: 8 letters, 2 edits.
+        assert_eq!(
+            unknown_key_hint("reflect", sphere).as_deref(),
+            Some("did you mean `reflection`?")
+        );
+        assert_eq!(unknown_key_hint("shine", sphere), None);
+        let light = &["position", "ambient", "diffuse", "specular"];
+        assert_eq!(
+            unknown_key_hint("positn", light).as_deref(),
+            Some("did you mean `position`?")
+        );
+        assert_eq!(unknown_key_hint("posit", light), None);
+    }
+
+    #[test]
+    fn a_quoted_token_is_cut_from_61_characters_on() {
+        let sixty = format!("unknown field `{}`", "k".repeat(60));
+        assert_eq!(cut_quoted(&sixty), sixty);
+        assert_eq!(
+            cut_quoted(&format!("unknown field `{}`", "k".repeat(61))),
+            format!(
+                "unknown field `{}…(11 characters)…{}`",
+                "k".repeat(40),
+                "k".repeat(10)
+            )
+        );
+    }
+
+    #[test]
+    fn float32_warns_of_a_sphere_a_thousand_radii_out_and_not_of_one_at_four_hundred() {
+        // |L·N| up to √(2u(7 + 2·1001)) = 0.0155 and √(2u(7 + 2·401)) = 0.0098.
+        let at = |z: &str| {
+            small(&format!(
+                "[[sphere]]\ncenter = [0, 0, -{z}]\nradius = 0.01\n"
+            ))
+            .unwrap()
+        };
+        let warnings = check_precision(&at("10"), Precision::F32).unwrap();
+        assert_eq!(warnings.len(), 1, "{warnings:#?}");
+        assert!(
+            warnings[0].starts_with(
+                "object 0 (a sphere, center [0, 0, -10], radius 0.01): its centre is 1.0e3 \
+                 radii from the origin"
+            ) && warnings[0].contains("|L·N| = 0.02)"),
+            "{}",
+            warnings[0]
+        );
+        assert_eq!(check_precision(&at("4"), Precision::F32), Ok(vec![]));
+    }
+
+    #[test]
+    fn the_deepest_line_is_counted_in_brackets_and_dots() {
+        assert_eq!(
+            deepest_nesting("[camera]\nposition = [0, 0, 1]\na.b = [[[[1]]]]\n"),
+            "line 3: nested too deeply for a scene file (about 5 levels of dotted keys, \
+             tables or lists on that line); a scene's keys are at most two levels deep, as in \
+             `[[sphere]]` then `radius = 0.5`"
+        );
+    }
+
+    #[test]
+    fn a_long_line_is_shown_from_40_characters_before_the_place() {
+        let text = format!("{}x = 1 #{}", " ".repeat(100), "c".repeat(200));
+        assert_eq!(
+            pointed(&text, 100..101, "here"),
+            format!(
+                "line 1, column 101: here\n  |\n1 | …{}x = 1 #{}…\n  | {}^",
+                " ".repeat(40),
+                "c".repeat(33),
+                " ".repeat(41)
+            )
+        );
+    }
+
+    #[test]
+    fn each_screen_edge_and_light_colour_is_named_in_its_message() {
+        assert_eq!(
+            small("[screen]\ntop = inf\n"),
+            Err("screen.top: inf is not a finite number".into())
+        );
+        assert_eq!(
+            whole(&SMALL.replace("[5, 5, 5]\n", "[5, 5, 5]\nspecular = [0, -1, 0]\n")),
+            Err(
+                "light.specular: [0.0, -1.0, 0.0] has a negative component; colours are 0 \
+                 or more"
+                    .into()
+            )
+        );
     }
 }
