@@ -813,6 +813,7 @@ fn json_outputs_carry_schema_1_and_the_documented_fields() {
             "light",
             "spheres",
             "planes",
+            "object_count",
             "objects",
         ],
     );
