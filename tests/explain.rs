@@ -303,3 +303,305 @@ fn a_story_among_many_spheres_counts_the_misses() {
         }
     }
 }
+
+fn close(a: f64, b: f64, tolerance: f64) -> bool {
+    (a - b).abs() <= tolerance * (1.0 + a.abs().max(b.abs()))
+}
+
+/// An early stop is told with the weight the path has left (the object's
+/// reflection, from the scene file) and `reach[left]`, the most the segments left
+/// could add, as the render's own tracer computes it.
+#[test]
+fn an_early_stop_names_the_weight_left_and_what_the_segments_left_could_add() {
+    use raystep::tools::explain::num;
+    let scene = common::scene(
+        "[image]\nwidth = 20\nheight = 15\n[camera]\nposition = [0, 0, 1]\n\
+         [light]\nposition = [5, 5, 5]\n[render]\nmax_depth = 3\n\
+         [[sphere]]\ncenter = [0, 0, -1]\nradius = 0.7\nambient = [0.1, 0, 0]\n\
+         diffuse = [0.7, 0, 0]\nreflection = 0.0001\n",
+    );
+    let settings = Settings::from(Stages::ALL);
+    let frame = render(&scene, &settings, &|_| {});
+    let story = explain(&scene, &settings, 10, 7);
+    check(&story, frame.at(7, 10), &settings);
+    assert_eq!(story.segments.len(), 1, "{story}");
+    // Three segments allowed, one used: two left, each of which could add at most
+    // reach[2] (weight 1) before the weight left scales it.
+    let reach = raystep::render::Tracer::<f64>::new(&scene, &settings).reach;
+    assert!(reach[2] > reach[1], "{reach:?}");
+    let end = format!(
+        "early stop after segment 0: the weight left, {}, times the most 2 more segments \
+         can add, {}, is below half an 8-bit step",
+        num(0.0001),
+        num(reach[2])
+    );
+    assert_eq!(story.end, end);
+    assert!(
+        story.to_string().contains(&format!("end: {end}\n")),
+        "{story}"
+    );
+}
+
+/// A shadow ray that meets an object only beyond the light leaves the point lit:
+/// a sphere at z = −3 (radius 1) lit by a light at z = −1, with a second sphere
+/// behind the camera, at z = 3 (radius 0.5), on the shadow ray's line.
+#[test]
+fn a_blocker_beyond_the_light_leaves_the_point_lit() {
+    use raystep::tools::explain::num;
+    let scene = common::scene(
+        "[image]\nwidth = 21\nheight = 21\n[camera]\nposition = [0, 0, 1]\n\
+         [light]\nposition = [0, 0, -1]\n\
+         [[sphere]]\ncenter = [0, 0, -3]\nradius = 1\n\
+         [[sphere]]\ncenter = [0, 0, 3]\nradius = 0.5\n",
+    );
+    let settings = Settings::from(Stages::ALL);
+    let frame = render(&scene, &settings, &|_| {});
+    let story = explain(&scene, &settings, 10, 10);
+    let record = frame.at(10, 10);
+    assert_eq!(record.shadow, 1.0, "the render lights the point");
+    check(&story, record, &settings);
+    let hit = story.segments[0].hit.as_ref().expect("the near sphere");
+    assert!(hit.lit && hit.shading.is_some(), "{story}");
+    let shadow = hit.shadow.as_ref().expect("a shadow ray");
+    // From (0, 0, −2) (about: the pixel is the centre one) to the light at z = −1,
+    // and on to the far sphere's near side at z = 2.5.
+    let (object, t) = shadow.blocker.expect("the sphere behind the camera");
+    assert_eq!(object, 1);
+    assert!((shadow.light_distance - 1.0).abs() < 1e-3, "{story}");
+    assert!((t - 4.5).abs() < 1e-2, "{story}");
+    let line = format!(
+        "    → object 1 at {}, beyond the light ({}): lit\n",
+        num(t),
+        num(shadow.light_distance)
+    );
+    assert!(story.to_string().contains(&line), "{story}");
+}
+
+/// With the tutorial's fixed offset, a hit point is moved 1e-5 along its normal,
+/// and the shadow ray and the reflection start from the moved point.
+#[test]
+fn the_moved_point_is_1e_5_along_the_normal_and_new_rays_start_there() {
+    let scene = common::seed(300, 200);
+    let settings = Settings::tutorial(Stages::ALL);
+    let story = explain(&scene, &settings, 152, 81);
+    let hit = story.segments[0].hit.as_ref().expect("the red sphere");
+    for k in 0..3 {
+        let moved = hit.point[k] + 1e-5 * hit.normal[k];
+        assert!(close(hit.shifted[k], moved, 1e-12), "{story}");
+    }
+    assert!(close(hit.offset, 1e-5, 1e-9), "{}", hit.offset);
+    let shadow = hit.shadow.as_ref().expect("a shadow ray");
+    assert_eq!(shadow.ray.origin, hit.shifted);
+    // The light, at (5, 5, 5), measured from the hit point.
+    let to_light = [0, 1, 2].map(|k| 5.0 - hit.point[k]);
+    let distance = to_light.iter().map(|c| c * c).sum::<f64>().sqrt();
+    assert!(close(shadow.light_distance, distance, 1e-12), "{story}");
+    let reflection = &story.segments[1];
+    assert_eq!(reflection.ray.origin, hit.shifted);
+}
+
+/// With several samples per pixel the story gives their mean as the record keeps
+/// it (in float32, exactly), the number of samples, and says so in words.
+#[test]
+fn with_several_samples_the_story_gives_their_mean_as_the_record_keeps_it() {
+    use raystep::tools::explain::num;
+    let scene = common::seed(60, 40);
+    let settings = Settings {
+        spp: 4,
+        ..Settings::from(Stages::ALL)
+    };
+    let frame = render(&scene, &settings, &|_| {});
+    let mut differ = 0;
+    for (x, y) in [(28, 12), (30, 20), (45, 30), (10, 35), (0, 0)] {
+        let story = explain(&scene, &settings, x, y);
+        let record = frame.at(y, x);
+        let samples = story.samples.as_ref().expect("four samples");
+        assert_eq!(samples.spp, 4);
+        assert_eq!(samples.colour, record.colour.map(f64::from), "{x},{y}");
+        let text = story.to_string();
+        let [r, g, b] = record.colour.map(|c| num(f64::from(c)));
+        let line = format!("with 4 samples the pixel is their mean, ({r}, {g}, {b}); ");
+        assert!(text.contains(&line), "{text}");
+        assert!(story.rules.ends_with(", 4 samples per pixel"), "{text}");
+        differ += usize::from(samples.colour != story.colour);
+    }
+    assert!(
+        differ > 0,
+        "a pixel whose mean is not its centre ray's colour"
+    );
+}
+
+/// The float32 story tells float32 numbers: the screen point and the rays and
+/// hits are float32 values, near the float64 story's.
+#[test]
+fn a_float32_story_tells_float32_numbers() {
+    let scene = common::seed(60, 40);
+    let f32_settings = Settings {
+        precision: Precision::F32,
+        ..Settings::from(Stages::ALL)
+    };
+    let is_f32 = |v: [f64; 3]| v.iter().all(|&c| f64::from(c as f32) == c);
+    for (x, y) in [(28, 12), (31, 17), (10, 35), (0, 0)] {
+        let story = explain(&scene, &f32_settings, x, y);
+        let wide = explain(&scene, &Settings::from(Stages::ALL), x, y);
+        let at = format!("pixel {x},{y}: {story}");
+        assert!(is_f32(story.screen_point), "{at}");
+        for k in 0..3 {
+            assert!(
+                close(story.screen_point[k], wide.screen_point[k], 1e-6),
+                "{at}"
+            );
+        }
+        assert!(is_f32(story.primary.direction), "{at}");
+        for segment in &story.segments {
+            assert!(
+                is_f32(segment.ray.origin) && is_f32(segment.ray.direction),
+                "{at}"
+            );
+            if let Some(hit) = &segment.hit {
+                assert!(f64::from(hit.t as f32) == hit.t, "{at}");
+                assert!(is_f32(hit.point) && is_f32(hit.normal), "{at}");
+            }
+        }
+    }
+}
+
+/// With only the rays stage on, the colour is the primary ray's direction,
+/// normalize(screen point − camera), each component mapped from [−1, 1] to
+/// [0, 1]: nothing to clip.
+#[test]
+fn with_only_the_rays_stage_the_colour_is_the_direction_mapped() {
+    use raystep::tools::explain::num;
+    let scene = common::seed(60, 40);
+    let settings = Settings::from(Stages::up_to(Stage::Rays));
+    let frame = render(&scene, &settings, &|_| {});
+    for (x, y) in [(0, 0), (30, 20), (59, 39)] {
+        let story = explain(&scene, &settings, x, y);
+        let p = story.screen_point;
+        let towards = [p[0], p[1], p[2] - 1.0]; // the camera is at (0, 0, 1)
+        let length = towards.iter().map(|c| c * c).sum::<f64>().sqrt();
+        for (k, towards) in towards.into_iter().enumerate() {
+            let mapped = (towards / length + 1.0) / 2.0;
+            assert!(close(story.unclipped[k], mapped, 1e-9), "{story}");
+            assert_eq!(story.unclipped[k], story.colour[k], "{story}");
+        }
+        assert_eq!(story.colour.map(|c| c as f32), frame.at(y, x).colour);
+        let [r, g, b] = story.colour.map(num);
+        let line = format!("colour: ({r}, {g}, {b}) → clipped to [0, 1]: ({r}, {g}, {b})");
+        assert!(story.to_string().contains(&line), "{story}");
+    }
+}
+
+/// A true plane's test names it as the scene file does and gives its one
+/// crossing, `(point − origin)·N / (direction·N)`: ahead of a ray looking down at
+/// it, behind one looking up.
+#[test]
+fn a_true_planes_test_names_it_and_gives_its_crossing() {
+    let path = format!("{}/scenes/true-plane.toml", env!("CARGO_MANIFEST_DIR"));
+    let mut scene = raystep::io::scene_file::load(path.as_ref()).unwrap();
+    (scene.width, scene.height) = (60, 40);
+    let settings = Settings::from(Stages::ALL);
+    for (x, y, ahead) in [(30, 39, true), (30, 0, false)] {
+        let story = explain(&scene, &settings, x, y);
+        let plane = &story.segments[0].tests[3];
+        assert_eq!(
+            plane.what,
+            "plane (the floor), through (0, -0.7, 0), normal (0, 1, 0)"
+        );
+        // The floor is y = −0.7 and the camera at y = 0.
+        let crossing = -0.7 / story.primary.direction[1];
+        assert_eq!(plane.roots.len(), 1, "{story}");
+        assert!(close(plane.roots[0], crossing, 1e-12), "{story}");
+        assert_eq!(crossing > 0.0, ahead);
+        if ahead {
+            assert_eq!(plane.t, Some(plane.roots[0]), "{story}");
+        } else {
+            assert_eq!(plane.verdict, "miss: the plane is behind the ray");
+        }
+    }
+}
+
+/// The naive method's discriminant is `Δ = b² − 4c` with `b = 2·d·(o − C)` and
+/// `c = ‖o − C‖² − r²` (a unit direction), and its misses are told with `Δ`.
+#[test]
+fn the_naive_method_tells_delta_and_its_value() {
+    let scene = common::seed(300, 200);
+    let settings = Settings::tutorial(Stages::ALL);
+    let story = explain(&scene, &settings, 152, 81);
+    let spheres = [
+        ([-0.2, 0.0, -1.0], 0.7),
+        ([0.1, -0.3, 0.0], 0.1),
+        ([-0.3, 0.0, 0.0], 0.15),
+        ([0.0, -9000.0, 0.0], 8999.3),
+    ];
+    let ray = &story.segments[0].ray;
+    let mut misses = 0;
+    for (test, (centre, radius)) in story.segments[0].tests.iter().zip(spheres) {
+        let f = [0, 1, 2].map(|k| ray.origin[k] - centre[k]);
+        let b = 2.0 * (0..3).map(|k| ray.direction[k] * f[k]).sum::<f64>();
+        let c = f.iter().map(|v| v * v).sum::<f64>() - radius * radius;
+        let delta = b * b - 4.0 * c;
+        let d = test.discriminant.expect("a sphere's discriminant");
+        assert!((d - delta).abs() <= 1e-9 * b * b, "{d} {delta}: {story}");
+        if delta < 0.0 {
+            assert_eq!(test.verdict, "miss: Δ < 0, the ray passes beside it");
+            misses += 1;
+        }
+    }
+    assert!(misses > 0, "{story}");
+}
+
+/// Each hit tells the path's sum so far: the segments' light times their
+/// weights, up to and with this segment's, which adds nothing in shadow.
+#[test]
+fn each_hit_tells_the_sum_so_far() {
+    let scene = common::seed(60, 40);
+    let settings = Settings::from(Stages::ALL);
+    let mut reflections_in_shadow = 0;
+    for y in 0..scene.height {
+        for x in 0..scene.width {
+            let story = explain(&scene, &settings, x, y);
+            let mut sum = [0.0f64; 3];
+            for segment in &story.segments {
+                let Some(hit) = &segment.hit else { break };
+                if let Some(light) = hit.illumination {
+                    (0..3).for_each(|k| sum[k] += light[k] * segment.weight);
+                } else if segment.index > 0 {
+                    reflections_in_shadow += 1;
+                }
+                for (told, sum) in hit.sum.into_iter().zip(sum) {
+                    assert!(close(told, sum, 1e-6), "{story}");
+                }
+            }
+        }
+    }
+    assert!(reflections_in_shadow > 0);
+}
+
+/// A path that ends in shadow after reflections names the segment it ended at:
+/// the render's count of reflections for that pixel.
+#[test]
+fn a_reflection_in_shadow_names_its_segment() {
+    let scene = common::seed(60, 40);
+    let settings = Settings::from(Stages::ALL);
+    let frame = render(&scene, &settings, &|_| {});
+    let mut told = 0;
+    for y in 0..scene.height {
+        for x in 0..scene.width {
+            let story = explain(&scene, &settings, x, y);
+            let record = frame.at(y, x);
+            let last = story.segments.last().and_then(|s| s.hit.as_ref());
+            if record.bounces == 0 || last.is_none_or(|h| h.lit) {
+                continue;
+            }
+            let end = format!(
+                "the point of segment {} does not see the light: the path ends there and adds \
+                 nothing more (the tutorial's rule)",
+                record.bounces
+            );
+            assert_eq!(story.end, end, "pixel {x},{y}");
+            told += 1;
+        }
+    }
+    assert!(told > 0);
+}
