@@ -352,6 +352,103 @@ fn the_contact_shadow_is_whole_with_the_auto_offset_and_holed_with_the_fixed_ste
     );
 }
 
+/// `pixels` is the image's size and `judged` the rays outside the silhouette
+/// band. On `graze` every ray passes within a millionth of the sphere's
+/// silhouette: inside float32's band (8·u·(‖O‖ + ‖C‖ + r + t) ≈ 4e-6), so float32
+/// judges none of them, and outside float64's (1e-9 of the radius; neighbouring
+/// rays are some 5e-8 apart there), so float64 judges them all.
+#[test]
+fn pixels_and_judged_count_the_image_and_the_rays_outside_the_band() {
+    let scene = case("graze").unwrap();
+    let pixels = (scene.width * scene.height) as usize;
+    assert_eq!(pixels, 160 * 120);
+    for method in [Naive, Stable] {
+        let f32 = run("graze", F32, method, AUTO);
+        assert_eq!((f32.pixels, f32.judged, f32.reference_hits), (pixels, 0, 0));
+        let f64 = run("graze", F64, method, AUTO);
+        assert_eq!((f64.pixels, f64.judged), (pixels, pixels), "{f64:?}");
+        assert!(f64.reference_hits > 0 && f64.reference_hits < pixels);
+    }
+    for (name, _) in CASES {
+        let scene = case(name).unwrap();
+        let m = run(name, F64, Stable, AUTO);
+        assert_eq!(m.pixels, (scene.width * scene.height) as usize, "{name}");
+        assert!(
+            m.reference_hits <= m.judged && m.judged <= m.pixels,
+            "{m:?}"
+        );
+    }
+}
+
+/// far-sphere with a wall behind it: every primary ray hits something, so a pixel
+/// where float32's textbook quadratic loses the sphere sees the wall instead,
+/// the wrong object, which counts as a false hit (the wall) and a false miss
+/// (the sphere), with either band.
+#[test]
+fn the_wrong_object_counts_as_a_false_hit_and_a_false_miss() {
+    let toml = "[image]\nwidth = 160\nheight = 120\n[camera]\nposition = [0, 0, 1]\n\
+                [screen]\nleft = -0.0003\nright = 0.0003\ntop = 0.000225\nbottom = -0.000225\n\
+                [light]\nposition = [2000, 2000, -3000]\n\
+                [[sphere]]\ncenter = [0, 0, -5000]\nradius = 1\n\
+                [[plane]]\npoint = [0, 0, -6000]\nnormal = [0, 0, 1]\n";
+    let scene = raystep::io::scene_file::parse(toml, "far-sphere-wall").unwrap();
+    let naive = measure("far-sphere-wall", &scene, F32, Naive, AUTO);
+    assert_eq!(
+        naive.reference_hits, naive.judged,
+        "every ray hits: {naive:?}"
+    );
+    assert!(naive.false_hits > 5000, "{naive:?}");
+    assert_eq!(naive.false_hits, naive.false_misses, "{naive:?}");
+    assert!(naive.strict_false.0 >= naive.false_hits, "{naive:?}");
+    assert_eq!(naive.strict_false.0, naive.strict_false.1, "{naive:?}");
+    let stable = measure("far-sphere-wall", &scene, F64, Stable, AUTO);
+    assert_eq!(stable.reference_hits, stable.pixels, "{stable:?}");
+    assert_eq!((stable.false_hits, stable.false_misses), (0, 0));
+}
+
+/// `raystep accuracy --json` reports each row's figures under their own names:
+/// far-sphere's float32 textbook rows miss every pixel of the sphere (false
+/// misses, no false hits), and every count is the library's.
+#[test]
+fn the_json_rows_carry_each_figure_under_its_own_name() {
+    let dir = std::env::temp_dir();
+    let out = common::raystep(&dir, &["accuracy", "--case", "far-sphere", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = rows.as_array().unwrap();
+    let measured = raystep::tools::accuracy::measure_case("far-sphere");
+    assert_eq!(rows.len(), measured.len());
+    for (row, m) in rows.iter().zip(&measured) {
+        assert_eq!(row["method"], m.method.as_str(), "{row}");
+        assert_eq!(row["precision"], m.precision.as_str(), "{row}");
+        assert_eq!(row["offset"], m.offset.as_str(), "{row}");
+        for (field, value) in [
+            ("pixels", m.pixels),
+            ("judged", m.judged),
+            ("reference_hits", m.reference_hits),
+            ("false_hits", m.false_hits),
+            ("false_misses", m.false_misses),
+            ("wrong_shadows", m.wrong_shadows),
+            ("wrong_shadows_1e3", m.wrong_shadows_1e3),
+        ] {
+            assert_eq!(row[field], value, "{field}: {row}");
+        }
+        assert_eq!(
+            row["strict_false"],
+            serde_json::json!([m.strict_false.0, m.strict_false.1])
+        );
+        if (row["precision"].as_str(), row["method"].as_str()) == (Some("f32"), Some("naive")) {
+            assert_eq!(row["false_hits"], 0, "{row}");
+            assert_eq!(row["false_misses"], row["reference_hits"], "{row}");
+            assert!(row["false_misses"].as_u64().unwrap() > 5000, "{row}");
+        }
+    }
+}
+
 // ---- Property tests: random spheres and rays at scales from 1e-3 to 1e4 ----
 
 /// The book's `step_off` with the `auto` offset, as the render moves a hit point.
