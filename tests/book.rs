@@ -388,19 +388,36 @@ fn the_numbers_the_chapters_quote_are_measured_again() {
     // the red sphere and the floor.
     let auto = render_command(defaults, &root()).unwrap();
     let fixed = render_command("render --offset fixed:1e-5", &root()).unwrap();
-    let differing: Vec<_> = (auto.pixels.iter().zip(&fixed.pixels))
-        .filter(|(a, b)| (0..3).any(|c| (a.colour[c] - b.colour[c]).abs() > 1.0 / 255.0))
-        .collect();
+    let tutorial = render_command("render --tutorial", &root()).unwrap();
+    // Where `other`'s colour differs from the defaults' by more than one 8-bit
+    // step, the pixels `compare` counts in `over_one_step`.
+    let places = |other: &raystep::aov::Frame| -> Vec<usize> {
+        (auto.pixels.iter().zip(&other.pixels).enumerate())
+            .filter(|(_, (a, b))| (0..3).any(|c| (a.colour[c] - b.colour[c]).abs() > 1.0 / 255.0))
+            .map(|(i, _)| i)
+            .collect()
+    };
+    let differing = places(&fixed);
+    let colours = |frame: &raystep::aov::Frame| -> Vec<[f32; 3]> {
+        frame.pixels.iter().map(|p| p.colour).collect()
+    };
+    let width = auto.width as usize;
     assert_eq!(
         differing.len(),
-        diff(defaults, "render --offset fixed:1e-5").over_one_step
+        compare(&colours(&auto), &colours(&fixed), width).over_one_step
     );
-    let (masked, lit): (Vec<_>, Vec<_>) = differing.iter().partition(|(a, b)| a.shadow != b.shadow);
-    for (a, b) in &lit {
+    let (masked, lit): (Vec<usize>, Vec<usize>) = differing
+        .iter()
+        .partition(|&&i| auto.pixels[i].shadow != fixed.pixels[i].shadow);
+    for (a, b) in lit.iter().map(|&i| (&auto.pixels[i], &fixed.pixels[i])) {
         assert_eq!((a.shadow, b.shadow), (1.0, 1.0), "{a:?} {b:?}");
         assert_ne!(a.rays, b.rays, "{a:?} {b:?}");
     }
-    let on = |object: u32| lit.iter().filter(|(a, _)| a.object == object).count();
+    let on = |object: u32| {
+        lit.iter()
+            .filter(|&&i| auto.pixels[i].object == object)
+            .count()
+    };
     assert_eq!(on(0) + on(3), lit.len());
     let quoted = format!(
         "In {} of them, along the edges of the dark sides, the shadow mask differs; the \
@@ -415,14 +432,7 @@ fn the_numbers_the_chapters_quote_are_measured_again() {
         "chapter 4 should say {quoted:?}"
     );
     // Chapter 9: `--tutorial` changes the same pixels as its step alone.
-    let tutorial = render_command("render --tutorial", &root()).unwrap();
-    let places = |other: &raystep::aov::Frame| -> Vec<usize> {
-        (auto.pixels.iter().zip(&other.pixels).enumerate())
-            .filter(|(_, (a, b))| (0..3).any(|c| (a.colour[c] - b.colour[c]).abs() > 1.0 / 255.0))
-            .map(|(i, _)| i)
-            .collect()
-    };
-    assert_eq!(places(&tutorial), places(&fixed));
+    assert_eq!(places(&tutorial), differing);
     let quoted = format!(
         "{} along the edges of the dark sides, which the 1e-5 step wrongly lit, and {} lit \
          in both whose reflected rays take another path (the same {} pixels as",
