@@ -7,7 +7,9 @@ mod common;
 use raystep::aov::{Frame, PixelRecord, NO_OBJECT};
 use raystep::real::Precision;
 use raystep::render::{render, Settings};
-use raystep::scene::Scene;
+use raystep::scene::{Scene, Shape};
+use raystep::shade::blinn_phong::Viewer;
+use raystep::sphere::Method;
 use raystep::stages::{Stage, Stages};
 use raystep::tools::explain::{explain, Explanation};
 
@@ -112,6 +114,13 @@ fn the_story_of_every_pixel_ends_where_the_render_did() {
         &scene,
         &Settings {
             spp: 4,
+            ..Settings::from(Stages::ALL)
+        },
+    );
+    agrees_everywhere(
+        &scene,
+        &Settings {
+            viewer: Viewer::RayOrigin,
             ..Settings::from(Stages::ALL)
         },
     );
@@ -604,4 +613,142 @@ fn a_reflection_in_shadow_names_its_segment() {
         }
     }
     assert!(told > 0);
+}
+
+/// A 3 × 3 picture whose middle ray, from the camera at z = 1 through the screen's
+/// centre, runs exactly along −z: one sphere it only touches (centre 1 above the
+/// ray, radius 1), one behind the camera (its roots −5 and −3), and a true plane
+/// the ray runs parallel to. Every discriminant here is exact in float64.
+const GRAZED: &str = r#"
+[image]
+width = 3
+height = 3
+
+[camera]
+position = [0, 0, 1]
+
+[light]
+position = [5, 5, 5]
+
+[[sphere]] # touched: f = o − C = (0, −1, 4), so f + (−f·d)·d = (0, −1, 0)
+center = [0, 1, -3]
+radius = 1
+ambient = [0.1, 0, 0]
+diffuse = [0.7, 0, 0]
+
+[[sphere]] # behind the camera
+center = [0, 0, 5]
+radius = 1
+ambient = [0, 0.1, 0]
+diffuse = [0, 0.6, 0]
+
+[[plane]]
+point = [0, -0.7, 0]
+normal = [0, 1, 0]
+ambient = [0.1, 0.1, 0.1]
+diffuse = [0.6, 0.6, 0.6]
+"#;
+
+/// Each way a ray can miss is told in its own words: a discriminant of exactly 0
+/// (a ray that only touches the sphere: the tutorial asks Δ > 0), both roots
+/// behind the ray, a plane the ray runs parallel to, and (from an infinite
+/// input, which no scene file can hold) a discriminant that is not a number.
+#[test]
+fn each_kind_of_miss_is_told_as_what_it_is() {
+    let mut scene = common::scene(GRAZED);
+    let frame = render(&scene, &Settings::from(Stages::ALL), &|_| {});
+    assert_eq!(
+        frame.at(1, 1).object,
+        NO_OBJECT,
+        "the middle ray meets nothing"
+    );
+    // Δ/4 = r² − ‖f + h·d‖² = 1 − 1; Δ = b² − 4c = (−8)² − 4·(17 − 1).
+    for (method, name) in [(Method::Stable, "Δ/4"), (Method::Naive, "Δ")] {
+        let settings = Settings {
+            method,
+            ..Settings::from(Stages::ALL)
+        };
+        let story = explain(&scene, &settings, 1, 1);
+        assert_eq!(story.primary.direction, [0.0, 0.0, -1.0]);
+        assert!(story.segments[0].hit.is_none(), "{story}");
+        assert_eq!(story.depth, None);
+        let [tangent, behind, plane] = &story.segments[0].tests[..] else {
+            panic!("three tests: {story}")
+        };
+        assert_eq!(tangent.discriminant, Some(0.0), "{story}");
+        assert!(tangent.roots.is_empty() && tangent.t.is_none(), "{story}");
+        assert_eq!(
+            tangent.verdict,
+            format!("miss: {name} = 0, the ray only touches it")
+        );
+        // From z = 1 along −z, the sphere around z = 5 of radius 1 is met at
+        // t = −5 and t = −3.
+        assert_eq!(behind.roots.len(), 2, "{story}");
+        assert!(close(behind.roots[0], -5.0, 1e-12), "{story}");
+        assert!(close(behind.roots[1], -3.0, 1e-12), "{story}");
+        assert_eq!(
+            behind.verdict,
+            "miss: both roots negative, the sphere is behind the ray"
+        );
+        // d·N = 0: no crossing to give.
+        assert_eq!(plane.discriminant, None);
+        assert!(plane.roots.is_empty() && plane.t.is_none(), "{story}");
+        assert_eq!(plane.verdict, "miss: the ray runs parallel to the plane");
+        assert!(
+            story
+                .to_string()
+                .contains(&format!("→ miss: {name} = 0, the ray only touches it")),
+            "{story}"
+        );
+    }
+    // A centre at infinity makes f·d = (−∞)·0, not a number: still a miss.
+    let Shape::Sphere(s) = &mut scene.objects[0].shape else {
+        panic!("the first object is a sphere")
+    };
+    s.center.y = f64::INFINITY;
+    let story = explain(&scene, &Settings::from(Stages::ALL), 1, 1);
+    let tangent = &story.segments[0].tests[0];
+    assert!(tangent.discriminant.is_some_and(f64::is_nan), "{story}");
+    assert_eq!(tangent.verdict, "miss: Δ/4 is not a number");
+}
+
+/// With `--viewer ray-origin`, Blinn-Phong's V at each hit points back along the
+/// ray that found it, to that ray's origin: the camera for the primary ray, the
+/// moved point of the last hit for a reflection (which is not the camera's
+/// direction). The rules say so.
+#[test]
+fn with_the_ray_origin_as_viewer_v_points_back_to_each_rays_start() {
+    let scene = common::seed(60, 40);
+    let settings = Settings {
+        viewer: Viewer::RayOrigin,
+        ..Settings::from(Stages::ALL)
+    };
+    let unit = |v: [f64; 3]| {
+        let n = v.iter().map(|c| c * c).sum::<f64>().sqrt();
+        v.map(|c| c / n)
+    };
+    let (mut reflections, mut unlike_the_camera) = (0, 0);
+    for y in 0..scene.height {
+        for x in 0..scene.width {
+            let story = explain(&scene, &settings, x, y);
+            assert!(story.rules.contains("viewer ray origin"), "{}", story.rules);
+            for segment in &story.segments {
+                let Some(hit) = &segment.hit else { break };
+                let Some(shading) = &hit.shading else {
+                    continue;
+                };
+                let back = unit([0, 1, 2].map(|k| segment.ray.origin[k] - hit.point[k]));
+                let to_camera = unit([0, 1, 2].map(|k| [0.0, 0.0, 1.0][k] - hit.point[k]));
+                for (told, back) in shading.to_viewer.into_iter().zip(back) {
+                    assert!(close(told, back, 1e-9), "{story}");
+                }
+                if segment.index > 0 {
+                    reflections += 1;
+                    let apart = (0..3).any(|k| !close(shading.to_viewer[k], to_camera[k], 1e-3));
+                    unlike_the_camera += usize::from(apart);
+                }
+            }
+        }
+    }
+    assert!(reflections > 0 && unlike_the_camera > 0);
 }
