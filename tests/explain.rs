@@ -694,10 +694,13 @@ fn each_kind_of_miss_is_told_as_what_it_is() {
         assert_eq!(plane.discriminant, None);
         assert!(plane.roots.is_empty() && plane.t.is_none(), "{story}");
         assert_eq!(plane.verdict, "miss: the ray runs parallel to the plane");
+        let text = story.to_string();
         assert!(
-            story
-                .to_string()
-                .contains(&format!("→ miss: {name} = 0, the ray only touches it")),
+            text.contains(&format!("; discriminant {name} = 0\n")),
+            "{story}"
+        );
+        assert!(
+            text.contains(&format!("→ miss: {name} = 0, the ray only touches it")),
             "{story}"
         );
     }

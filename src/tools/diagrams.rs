@@ -2126,6 +2126,14 @@ mod tests {
         ] {
             assert!(svg.contains(label), "{label}");
         }
+        // The caption says where the rays start.
+        let chapter = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/chapters/03-intersection.md"
+        ))
+        .unwrap();
+        let [a, b, c] = ROOTS_HEIGHTS.map(|y| y.to_string().replace('-', "−"));
+        assert!(chapter.contains(&format!("from\n(0, y, 0) with y = {a}, {b} and {c}.")));
     }
 
     #[test]

@@ -33,6 +33,11 @@ pub struct Explanation {
     /// Precision, intersection method, offset, viewer, early stop and samples per
     /// pixel, in words.
     pub rules: String,
+    /// The intersection method, which decides what each sphere's `discriminant`
+    /// is: `Δ` or `Δ/4` ([`discriminant_name`]). The JSON leaves it out: `rules`
+    /// says it.
+    #[serde(skip)]
+    pub method: Method,
     /// The pixel's point on the screen rectangle.
     pub screen_point: [f64; 3],
     /// The primary ray: the camera towards the screen point.
@@ -216,6 +221,7 @@ fn explain_in<T: Real>(scene: &Scene, settings: &Settings, x: u32, y: u32) -> Ex
             y,
             stages: settings.stages.to_string(),
             rules: rules(settings),
+            method: settings.method,
             screen_point: tracer
                 .camera
                 .screen_point::<T>(row, col)
@@ -433,10 +439,7 @@ fn judge<T: Real>(index: usize, object: &Object<T>, ray: &Ray<T>, method: Method
                 Method::Naive => (s.discriminant_naive(ray), s.roots_naive(ray)),
                 Method::Stable => (s.quarter_discriminant(ray), s.roots_stable(ray)),
             };
-            let name = match method {
-                Method::Naive => "Δ",
-                Method::Stable => "Δ/4",
-            };
+            let name = discriminant_name(method);
             let d = discriminant.to_f64();
             let roots: Vec<f64> = roots.map_or(Vec::new(), |(a, b)| vec![a.to_f64(), b.to_f64()]);
             let verdict = match (t, roots.as_slice()) {
@@ -481,6 +484,16 @@ fn judge<T: Real>(index: usize, object: &Object<T>, ray: &Ray<T>, method: Method
                 verdict,
             }
         }
+    }
+}
+
+/// What a sphere's test computes as its discriminant under `method`: the naive
+/// method's `Δ = b² − 4c`, or the stable method's `Δ/4 = r² − ‖f + h·d‖²`
+/// (chapter 9), which has the same sign.
+pub fn discriminant_name(method: Method) -> &'static str {
+    match method {
+        Method::Naive => "Δ",
+        Method::Stable => "Δ/4",
     }
 }
 
@@ -602,7 +615,8 @@ impl std::fmt::Display for Explanation {
             for t in &s.tests {
                 write!(f, "  object {}: {}", t.object, t.what)?;
                 if let Some(d) = t.discriminant {
-                    write!(f, "; discriminant {}", num(d))?;
+                    let name = discriminant_name(self.method);
+                    write!(f, "; discriminant {name} = {}", num(d))?;
                 }
                 if !t.roots.is_empty() {
                     let roots: Vec<String> = t.roots.iter().map(|&r| num(r)).collect();
