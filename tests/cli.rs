@@ -567,6 +567,49 @@ fn chart_writes_its_csv_svg_and_png() {
         .starts_with("<svg"));
 }
 
+/// The chart's numbers say what chapter 10 says of them: one row, `default`, is
+/// raystep's default; more samples divide the error (16 below 4 below 1); a
+/// `max_depth` of 1 misses reflections that 2 already has; float32 moves pixels;
+/// acceleration, early stop and the book engine change none (the default's error
+/// exactly); and no pixel's error is below the root mean square of them all.
+#[test]
+fn the_charts_errors_rank_the_settings_as_chapter_10_describes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = raystep(
+        dir.path(),
+        &[
+            "chart", "--width", "32", "--height", "18", "--runs", "1", "--out", "c",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let csv = std::fs::read_to_string(dir.path().join("c/chart.csv")).unwrap();
+    let mut reader = csv::Reader::from_reader(csv.as_bytes());
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    let row = |setting: &str| {
+        rows.iter()
+            .find(|r| &r[0] == setting)
+            .unwrap_or_else(|| panic!("no row {setting}: {csv}"))
+    };
+    let rmse = |setting: &str| -> f64 { row(setting)[2].parse().unwrap() };
+    let defaults: Vec<&str> = rows
+        .iter()
+        .filter(|r| &r[4] == "true")
+        .map(|r| &r[0])
+        .collect();
+    assert_eq!(defaults, ["default"], "{csv}");
+    assert!(rmse("spp 16") < rmse("spp 4"), "{csv}");
+    assert!(rmse("spp 4") < rmse("default"), "{csv}");
+    assert!(rmse("depth 1") > rmse("depth 2"), "{csv}");
+    assert_ne!(rmse("f32"), rmse("default"), "{csv}");
+    for same in ["accel off", "early stop off", "book engine"] {
+        assert_eq!(rmse(same), rmse("default"), "{same}: {csv}");
+    }
+    for r in &rows {
+        let (rmse, worst): (f64, f64) = (r[2].parse().unwrap(), r[3].parse().unwrap());
+        assert!(worst >= rmse, "{r:?}");
+    }
+}
+
 /// Run raystep in `dir` with `input` on its standard input.
 fn raystep_with_input(dir: &Path, args: &[&str], input: &[u8]) -> std::process::Output {
     use std::io::Write;

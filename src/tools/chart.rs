@@ -877,6 +877,255 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// Ties decide the frontier too: a point as accurate as another but slower, or
+    /// as fast but less accurate, is beaten (the committed chart's `default` is off
+    /// the frontier because `naive` has its error exactly, in less time).
+    #[test]
+    fn a_point_tied_on_one_axis_and_worse_on_the_other_is_off_the_frontier() {
+        let mut points = vec![
+            point("naive", 7.1, 2.1),
+            point("default, as accurate and slower", 7.5, 2.1),
+            point("as fast and rougher", 7.1, 3.0),
+            point("slower and finer", 9.0, 1.0),
+        ];
+        mark_frontier(&mut points);
+        let on: Vec<bool> = points.iter().map(|p| p.frontier).collect();
+        assert_eq!(on, [true, false, false, true]);
+    }
+
+    /// The frontier weighs time against the root mean square error, the chart's y
+    /// axis, not against the worst pixel: a point faster and lower in RMSE beats
+    /// another whatever their worst pixels.
+    #[test]
+    fn the_frontier_weighs_the_rmse_not_the_worst_pixel() {
+        let mut points = vec![
+            point("fast, fine", 1.0, 1.0),
+            point("slow, rough", 2.0, 2.0),
+        ];
+        points[0].worst = 100.0;
+        points[1].worst = 1.0;
+        mark_frontier(&mut points);
+        assert!(points[0].frontier && !points[1].frontier, "{points:?}");
+    }
+
+    /// The error of one known difference: two pixels whose channels differ by
+    /// (+1, +1, −5) and (+1, −5, +1) levels. Squares 1 + 1 + 25 twice, 54 over six
+    /// channels, 9, whose root is 3 levels; the worst is the 5 levels below, in the
+    /// blue channel of the first pixel and the green of the second.
+    #[test]
+    fn the_error_is_the_root_mean_square_over_every_channel_and_the_worst_difference() {
+        let mut scene = crate::tools::generate::scene(1, 1);
+        (scene.width, scene.height) = (2, 1);
+        let mut reference = Frame::blank(scene.camera(), Precision::F64);
+        let mut frame = reference.clone();
+        let base = [0.5f32, 0.5, 0.5];
+        let level = 1.0 / 255.0;
+        for (i, diff) in [[1.0f32, 1.0, -5.0], [1.0, -5.0, 1.0]].iter().enumerate() {
+            reference.pixels[i].colour = base;
+            for c in 0..3 {
+                frame.pixels[i].colour[c] = base[c] + diff[c] * level;
+            }
+        }
+        let (rmse, worst) = error(&frame, &reference);
+        assert!((rmse - 3.0).abs() < 1e-4, "rmse {rmse}");
+        assert!((worst - 5.0).abs() < 1e-4, "worst {worst}");
+        // The same frame against itself: no error at all.
+        assert_eq!(error(&reference, &reference), (0.0, 0.0));
+    }
+
+    /// The CSV's header and one row as the committed `chapters/charts/chart.csv`
+    /// has them: median in milliseconds, RMSE, then the worst pixel.
+    #[test]
+    fn the_chart_csv_has_the_documented_columns_in_order() {
+        let mut p = point("default", 7.454, 2.1062);
+        p.worst = 121.75;
+        p.default = true;
+        let text = csv(&[p]);
+        assert_eq!(
+            text,
+            "setting,median_ms,rmse_levels,worst_levels,default,frontier\n\
+             default,7.454,2.1062,121.75,true,false\n"
+        );
+    }
+
+    /// The scale CSV's columns, as chapter 10 and the committed
+    /// `chapters/charts/scale.csv` name them, each from its own field.
+    #[test]
+    fn the_scale_csv_has_the_documented_columns_in_order() {
+        let points = [
+            ScalePoint {
+                count: 30,
+                series: Series::Raystep(Accel::Auto),
+                median_s: 0.051,
+                trace_s: 0.050,
+                build_s: 0.001,
+                bvh_bytes: 1234,
+            },
+            ScalePoint {
+                count: 30,
+                series: Series::Embree,
+                median_s: 0.0775,
+                trace_s: 0.0775,
+                build_s: 0.0075,
+                bvh_bytes: 0,
+            },
+        ];
+        assert_eq!(
+            scale_csv(&points),
+            "spheres,accel,median_ms,bvh_build_ms,bvh_bytes,trace_ms\n\
+             30,auto,51.000,1.000,1234,50.000\n\
+             30,embree,77.500,7.500,0,77.500\n"
+        );
+    }
+
+    /// The renders of a sweep of two runs: the reference, then for each of the
+    /// seventeen settings a warm-up and two timed runs, 1 + 17 × 3.
+    #[test]
+    fn a_sweep_counts_the_reference_the_warm_ups_and_the_runs() {
+        assert_eq!(sweep_renders(2), 52);
+    }
+
+    /// An axis over 2 to 50 reaches a factor of 1.6 beyond both ends: 1.25 to 80.
+    #[test]
+    fn a_log_range_leaves_a_margin_on_both_sides() {
+        let range = log_range([50.0, 2.0, 10.0].into_iter());
+        assert!((range.start - 1.25).abs() < 1e-12, "{range:?}");
+        assert!((range.end - 80.0).abs() < 1e-12, "{range:?}");
+    }
+
+    /// Exactly two decades is "two decades or more": the powers of ten alone.
+    #[test]
+    fn a_log_axis_of_exactly_two_decades_labels_the_powers_of_ten() {
+        assert_eq!(log_ticks(&(1.0..100.0)), [1.0, 10.0, 100.0]);
+    }
+
+    /// `--scale` renders every count with `--accel auto`, the plain loop up to
+    /// `plain_up_to` spheres included, and reports a tree (its bytes and build
+    /// time) only for `auto` from `BVH_FROM` (24) spheres on.
+    #[test]
+    fn scale_runs_the_plain_loop_up_to_its_limit_and_counts_a_tree_only_where_one_is_built() {
+        let from = crate::accel::BVH_FROM;
+        let points = scale(&[from - 1, from, from + 1], from, (8, 6), 1, None, &|_| {}).unwrap();
+        let rows: Vec<(usize, String, bool)> = points
+            .iter()
+            .map(|p| (p.count, p.series.to_string(), p.bvh_bytes > 0))
+            .collect();
+        let want = [
+            (from - 1, "auto", false),
+            (from - 1, "off", false),
+            (from, "auto", true),
+            (from, "off", false),
+            (from + 1, "auto", true),
+        ];
+        let want: Vec<(usize, String, bool)> = want
+            .iter()
+            .map(|&(n, s, tree)| (n, s.to_string(), tree))
+            .collect();
+        assert_eq!(rows, want);
+        for p in &points {
+            assert_eq!(p.build_s > 0.0, p.bvh_bytes > 0, "{p:?}");
+        }
+    }
+
+    /// A stand-in for the Embree program: it keeps its arguments and its standard
+    /// input in `dir`, prints the header of `benches/embree/spheres.cpp` and one
+    /// row (a build of 2.5 ms, a median of 40 ms), and exits with `code`.
+    fn fake_embree(dir: &Path, code: i32) -> std::path::PathBuf {
+        use std::os::unix::fs::PermissionsExt;
+        let program = dir.join(format!("embree-{code}"));
+        let script = format!(
+            "#!/bin/sh\n\
+             echo \"$@\" > '{args}'\n\
+             cat > '{stdin}'\n\
+             echo objects,width,height,threads,runs,geometry,build_ms,median_ms,min_ms,max_ms\n\
+             echo 4,8,6,1,1,user,2.5,40,39,41\n\
+             exit {code}\n",
+            args = dir.join("args").display(),
+            stdin = dir.join("stdin").display(),
+        );
+        std::fs::write(&program, script).unwrap();
+        std::fs::set_permissions(&program, std::fs::Permissions::from_mode(0o755)).unwrap();
+        program
+    }
+
+    /// With `--embree`, the program is run on the same scene (the generated one of
+    /// seed 1, as `raystep generate spheres` writes it) at the chart's size, and its
+    /// row is read by the names of its columns, milliseconds made seconds.
+    #[test]
+    fn scale_reads_the_embree_programs_row_by_its_column_names() {
+        let dir = std::env::temp_dir().join(format!("raystep-embree-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let program = fake_embree(&dir, 0);
+        let points = scale(&[4], 0, (8, 6), 1, Some(&program), &|_| {}).unwrap();
+        let embree: Vec<&ScalePoint> = points
+            .iter()
+            .filter(|p| p.series == Series::Embree)
+            .collect();
+        assert_eq!(embree.len(), 1, "{points:?}");
+        let p = embree[0];
+        assert_eq!(p.count, 4);
+        assert!((p.median_s - 0.040).abs() < 1e-12, "{p:?}");
+        assert!((p.trace_s - 0.040).abs() < 1e-12, "{p:?}");
+        assert!((p.build_s - 0.0025).abs() < 1e-12, "{p:?}");
+        let args = std::fs::read_to_string(dir.join("args")).unwrap();
+        assert!(
+            args.starts_with("--width 8 --height 6 --runs 1 --threads "),
+            "{args}"
+        );
+        let stdin = std::fs::read_to_string(dir.join("stdin")).unwrap();
+        assert_eq!(stdin, crate::tools::generate::spheres_toml(4, 1));
+        assert!(scale_csv(&points).contains("\n4,embree,40.000,2.500,0,40.000\n"));
+        // A program that fails is an error, whatever it printed.
+        let failing = fake_embree(&dir, 1);
+        let err = scale(&[4], 0, (8, 6), 1, Some(&failing), &|_| {}).unwrap_err();
+        assert!(
+            err.to_string().contains("the Embree program failed"),
+            "{err}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The blue line joins the frontier's points alone, left to right: of four
+    /// points three are on the frontier, so the SVG's blue lines are the frontier
+    /// of three vertices and the legend's sample of two.
+    #[test]
+    fn the_frontier_line_joins_only_the_frontier_points_in_order_of_time() {
+        let dir = std::env::temp_dir().join(format!("raystep-frontier-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut points = vec![
+            point("c", 3.0, 1.0),
+            point("a", 1.0, 3.0),
+            point("beaten", 4.0, 4.0),
+            point("b", 2.0, 2.0),
+        ];
+        mark_frontier(&mut points);
+        let mut pending = Pending::new();
+        let files = write_sweep(&mut pending, &dir, "f", &points, "test").unwrap();
+        pending.commit().unwrap();
+        let svg = std::fs::read_to_string(&files[0]).unwrap();
+        let mut lines: Vec<Vec<i64>> = svg
+            .split("<polyline")
+            .skip(1)
+            .filter(|e| e.contains("stroke=\"#0000FF\""))
+            .map(|e| {
+                let points = e.split("points=\"").nth(1).unwrap();
+                let points = &points[..points.find('"').unwrap()];
+                points
+                    .split_whitespace()
+                    .map(|xy| xy.split(',').next().unwrap().parse().unwrap())
+                    .collect()
+            })
+            .collect();
+        lines.sort_by_key(Vec::len);
+        assert_eq!(
+            lines.iter().map(Vec::len).collect::<Vec<_>>(),
+            [2, 3],
+            "{lines:?}"
+        );
+        assert!(lines[1].windows(2).all(|w| w[0] < w[1]), "{lines:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     fn tempfile_dir() -> std::path::PathBuf {
         let dir = std::env::temp_dir().join(format!("raystep-chart-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
