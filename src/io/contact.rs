@@ -439,6 +439,144 @@ mod tests {
         assert_eq!(png.dimensions(), (layout.width, 2 * MARGIN + HEADER_H));
     }
 
+    /// The height is scaled as the width is, to the nearest pixel: 300 × 100 at 200
+    /// wide is 66.7 high, so 67.
+    #[test]
+    fn a_thumbnails_height_rounds_to_the_nearest_pixel() {
+        assert_eq!(thumbnail_size(300, 100, 200), (200, 67));
+        assert_eq!(thumbnail_size(300, 100, 210), (210, 70));
+    }
+
+    /// The ink of the text in the rectangle `x0..x1` × `y0..y1`: the columns of its
+    /// leftmost and rightmost pixels that are not `ground`, if any.
+    fn ink(
+        png: &RgbImage,
+        (x0, x1): (u32, u32),
+        (y0, y1): (u32, u32),
+        ground: [u8; 3],
+    ) -> Option<(u32, u32)> {
+        let xs: Vec<u32> = (x0..x1)
+            .filter(|&x| (y0..y1).any(|y| png.get_pixel(x, y).0 != ground))
+            .collect();
+        Some((*xs.first()?, *xs.last()?))
+    }
+
+    /// README's columns, in its order: beauty, depth, normal, shadow; each name
+    /// drawn over its own cells, as wide as the font measures it (the ink within
+    /// 4 pixels of the measure, for the glyphs' side bearings: depth's ink is 43
+    /// pixels, normal's 51, so the two swapped are caught).
+    #[test]
+    fn the_columns_are_beauty_depth_normal_shadow_each_named_over_its_cells() {
+        assert_eq!(
+            COLUMNS.map(|b| b.name()),
+            ["beauty", "depth", "normal", "shadow"]
+        );
+        let (sheet, _) = sheet(120, 80, 90);
+        let png = decode(&sheet.png());
+        let layout = sheet.layout();
+        for (c, name) in ["beauty", "depth", "normal", "shadow"].iter().enumerate() {
+            let x = layout.cell_x(c);
+            let (left, right) = ink(
+                &png,
+                (x, x + layout.cell_w),
+                (MARGIN, MARGIN + HEADER_H),
+                BACKGROUND,
+            )
+            .unwrap_or_else(|| panic!("no name over column {c}"));
+            let drawn = right - left + 1;
+            let measured = text_width(name, TEXT_SIZE);
+            assert!(
+                drawn.abs_diff(measured) <= 4,
+                "{name}: {drawn} px drawn, {measured} measured"
+            );
+        }
+    }
+
+    /// Thumbnails lower than a line of text (16 × 8): each row is still a line high
+    /// (LINE_H, 22 px: the sheet 8 + 26 + 6 × (4 + 22) + 8 = 198 high), each
+    /// thumbnail in the middle of its cell (as wide as the "not written" note), and
+    /// each column's name within its cell.
+    #[test]
+    fn small_thumbnails_sit_centred_in_rows_a_line_of_text_high() {
+        let (sheet, last) = sheet(16, 8, 90);
+        let png = decode(&sheet.png());
+        assert_eq!(png.height(), 198);
+        let layout = sheet.layout();
+        let beauty =
+            RgbImage::from_raw(16, 8, crate::io::output::visualise(&last, Buffer::Beauty)).unwrap();
+        let (x, y) = (layout.cell_x(0), layout.row_y(5));
+        let (dx, dy) = ((layout.cell_w - 16) / 2, (22 - 8) / 2);
+        assert!(dx > 20, "the cell is {} wide", layout.cell_w);
+        for (px, py, p) in beauty.enumerate_pixels() {
+            assert_eq!(png.get_pixel(x + dx + px, y + dy + py), p, "({px}, {py})");
+        }
+        assert_eq!(png.get_pixel(x, y + 11).0, BACKGROUND);
+        assert_eq!(png.get_pixel(x + layout.cell_w - 1, y + 11).0, BACKGROUND);
+        // The names: no ink in the gaps between the cells of the header.
+        for c in 0..COLUMNS.len() {
+            let gap = (layout.cell_x(c) - GAP, layout.cell_x(c));
+            assert_eq!(
+                ink(&png, gap, (MARGIN, MARGIN + HEADER_H), BACKGROUND),
+                None,
+                "before column {c}"
+            );
+        }
+    }
+
+    /// Each row's label is drawn beside its own row, from the left margin, and
+    /// the label column is the longest label's ink and PAD (within 2 pixels): an
+    /// empty label above a long one leaves its row's label bare.
+    #[test]
+    fn each_label_is_beside_its_own_row_and_the_column_fits_the_longest() {
+        let mut scene = crate::io::scene_file::seed();
+        (scene.width, scene.height) = (40, 30);
+        let frame = render(&scene, &Settings::from(Stages::up_to(Stage::Rays)), &|_| {});
+        let mut sheet = ContactSheet::new(90);
+        sheet.add_row("", &frame);
+        sheet.add_row("WWWWWWWW", &frame);
+        let png = decode(&sheet.png());
+        let layout = sheet.layout();
+        let label = |r: usize| {
+            let y = layout.row_y(r);
+            ink(
+                &png,
+                (0, layout.cell_x(0)),
+                (y, y + layout.row_h[r]),
+                BACKGROUND,
+            )
+        };
+        assert_eq!(label(0), None, "the empty label's row has text");
+        let (left, right) = label(1).expect("the long label's row has no text");
+        assert!(left.abs_diff(MARGIN) <= 2, "the label starts at {left}");
+        let drawn = right - left + 1;
+        assert!(
+            (layout.label_w - PAD).abs_diff(drawn) <= 2,
+            "{drawn} px drawn, the column {} wide",
+            layout.label_w
+        );
+    }
+
+    /// With `--png srgb` the sheet shows the colour picture as its PNG file has it
+    /// (README: "as their files do"), not the linear bytes: a 60 × 40 frame is
+    /// shown unscaled, so the cell is the file's picture byte for byte.
+    #[test]
+    fn the_colour_thumbnail_is_encoded_as_its_png_file_is() {
+        let mut scene = crate::io::scene_file::seed();
+        (scene.width, scene.height) = (60, 40);
+        let frame = render(
+            &scene,
+            &Settings::from(Stages::up_to(Stage::Plane)),
+            &|_| {},
+        );
+        let srgb = crate::io::output::PngEncoding::Srgb;
+        let mut sheet = ContactSheet::new(90).with_png(srgb);
+        sheet.add_row("6 plane", &frame);
+        let file = crate::io::output::visualise_as(&frame, Buffer::Beauty, srgb);
+        assert_ne!(file, crate::io::output::visualise(&frame, Buffer::Beauty));
+        let cell = sheet.rows[0].cells[0].as_ref().unwrap();
+        assert_eq!(cell.as_raw(), &file);
+    }
+
     /// The seed scene at its own size, for looking at:
     /// `cargo test --lib contact -- --ignored` writes /tmp/contact-sheet.png.
     #[test]

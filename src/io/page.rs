@@ -466,4 +466,43 @@ mod tests {
         );
         assert!(has_numbers(1920, 1080) && !has_numbers(1080, 1921));
     }
+
+    /// Each number of a pixel's record is the field of its name, in the order of
+    /// [`FIELDS`] (R, G, B, depth, N.X, N.Y, N.Z, P.X, P.Y, P.Z, shadow, object,
+    /// bounces, rays): a record whose numbers all differ, and its fields written out
+    /// by hand (the position left 0, filled in from the primary ray).
+    #[test]
+    fn each_number_of_a_record_is_the_field_of_its_name() {
+        let record = PixelRecord {
+            colour: [0.1, 0.2, 0.3],
+            depth: 4.0,
+            normal: [0.5, 0.6, 0.7],
+            shadow: 1.0,
+            object: 9,
+            diffuse: 0.25,
+            specular: 0.125,
+            bounces: 2,
+            rays: 5,
+        };
+        assert_eq!(
+            record_fields(&record),
+            [0.1, 0.2, 0.3, 4.0, 0.5, 0.6, 0.7, 0.0, 0.0, 0.0, 1.0, 9.0, 2.0, 5.0]
+        );
+    }
+
+    /// The manifest states the render's size as asked (30 wide, 20 high: the page
+    /// draws its canvas and reads its pixels by them) and the largest render with
+    /// numbers, 1920 × 1080 = 2,073,600 pixels.
+    #[test]
+    fn the_manifest_states_the_size_and_the_largest_render_with_numbers() {
+        let html = index_html("s", 30, 20, &[stage("01-rays", &["beauty"])]);
+        let start = html.find("const MANIFEST = ").unwrap() + "const MANIFEST = ".len();
+        let end = start + html[start..].find(";\n").unwrap();
+        let manifest: serde_json::Value = serde_json::from_str(&html[start..end]).unwrap();
+        assert_eq!(
+            (&manifest["width"], &manifest["height"]),
+            (&30.into(), &20.into())
+        );
+        assert_eq!(manifest["numbersUpTo"], 2_073_600);
+    }
 }
