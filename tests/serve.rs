@@ -1237,6 +1237,408 @@ fn the_host_header_is_checked_exactly() {
     }
 }
 
+/// `GET target` with `extra` header lines (each ending in `\r\n`).
+fn get_with(server: &Server, target: &str, extra: &str) -> Reply {
+    let port = server.port;
+    server.raw(&format!(
+        "GET {target} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n{extra}Connection: close\r\n\r\n"
+    ))
+}
+
+/// The API's answers are JSON, refusals too, and say so; nothing it answers is
+/// kept by a cache (a scene file changes under the same URL), nor sniffed as
+/// another type.
+#[test]
+fn api_answers_are_json_and_never_cached() {
+    let server = Server::start(None);
+    for (target, status) in [
+        ("/api/scene", 200),
+        ("/api/pixel?x=1&y=1&width=8&height=8", 200),
+        ("/api/render?spp=3", 400),
+        ("/api/nothing", 404),
+    ] {
+        let reply = server.get(target);
+        assert_eq!(reply.status, status, "{target}");
+        assert_eq!(
+            reply.header("Content-Type"),
+            Some("application/json; charset=utf-8"),
+            "{target}"
+        );
+        assert_eq!(reply.header("Cache-Control"), Some("no-store"), "{target}");
+        assert_eq!(
+            reply.header("X-Content-Type-Options"),
+            Some("nosniff"),
+            "{target}"
+        );
+        reply.json();
+    }
+    let png = server.get("/api/render?width=8&height=8");
+    assert_eq!(png.header("Cache-Control"), Some("no-store"));
+}
+
+/// The page is `/` and `/index.html` alike ("the page's three files"), and no
+/// other site may show it in a frame (`X-Frame-Options: DENY`, as its policy's
+/// `frame-ancestors 'none'`).
+#[test]
+fn the_page_is_also_index_html_and_is_never_framed() {
+    let server = Server::start(None);
+    let root = server.get("/");
+    let index = server.get("/index.html");
+    assert_eq!(index.status, 200);
+    assert_eq!(index.body, root.body);
+    assert_eq!(
+        index.header("Content-Type"),
+        Some("text/html; charset=utf-8")
+    );
+    for page in [&root, &index] {
+        assert_eq!(page.header("X-Frame-Options"), Some("DENY"));
+        assert!(page
+            .header("Content-Security-Policy")
+            .unwrap()
+            .contains("frame-ancestors 'none'"));
+    }
+}
+
+/// A 405 says which methods are answered: HTTP requires its `Allow` header
+/// (RFC 9110, 15.5.6), and the README says GET and HEAD.
+#[test]
+fn a_refused_method_is_405_with_the_allowed_ones() {
+    let server = Server::start(None);
+    let port = server.port;
+    for method in ["POST", "PUT", "DELETE", "OPTIONS"] {
+        let reply = server.raw(&format!(
+            "{method} /api/scene HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 0\r\nConnection: close\r\n\r\n"
+        ));
+        assert_eq!(reply.status, 405, "{method}");
+        assert_eq!(reply.header("Allow"), Some("GET, HEAD"), "{method}");
+        assert!(reply.error().contains("GET"), "{method}");
+    }
+}
+
+/// `Sec-Fetch-Site`: the page's own requests (`same-origin`) and an address
+/// typed in (`none`) are answered; a page of any other origin, even a sibling
+/// subdomain (`same-site`), gets 403 (README, "Safety").
+#[test]
+fn only_the_page_itself_or_a_typed_address_passes_sec_fetch_site() {
+    let server = Server::start(None);
+    for (site, status) in [
+        ("same-origin", 200),
+        ("none", 200),
+        ("same-site", 403),
+        ("cross-site", 403),
+    ] {
+        let reply = get_with(
+            &server,
+            "/api/scene",
+            &format!("Sec-Fetch-Site: {site}\r\n"),
+        );
+        assert_eq!(reply.status, status, "{site}");
+    }
+}
+
+/// The saved scene's name is the file's, with `-studio.toml`, when that name
+/// is plain (letters, digits, `-`, `_`, `.`); any other name, a quote in it
+/// say, which would end the header's quoted filename, gives `scene-studio.toml`.
+#[test]
+fn the_saved_scene_is_named_after_a_plainly_named_file_only() {
+    let dir = tempfile::tempdir().unwrap();
+    for (file, saved) in [
+        ("my.scene_1-a.toml", "my.scene_1-a-studio.toml"),
+        ("a\"b.toml", "scene-studio.toml"),
+        ("two words.toml", "scene-studio.toml"),
+    ] {
+        let path = dir.path().join(file);
+        std::fs::write(&path, raystep::io::scene_file::SEED_TOML).unwrap();
+        let server = Server::start(Some(&path));
+        let reply = server.get("/api/scene.toml?light=1,2,3");
+        assert_eq!(reply.status, 200, "{file}");
+        assert_eq!(
+            reply.header("Content-Disposition"),
+            Some(format!("attachment; filename=\"{saved}\"").as_str()),
+            "{file}"
+        );
+        assert_eq!(
+            reply.header("Content-Type"),
+            Some("application/toml; charset=utf-8")
+        );
+    }
+}
+
+/// Open `/api/events` on `port` with `method`; the stream, and what it has
+/// sent once `needle` is in it.
+fn open_events(port: u16, method: &str, needle: &str) -> (TcpStream, Vec<u8>) {
+    let mut stream = TcpStream::connect(("127.0.0.1", port)).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_millis(200)))
+        .unwrap();
+    write!(
+        stream,
+        "{method} /api/events HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n"
+    )
+    .unwrap();
+    let mut seen = Vec::new();
+    read_until(&mut stream, &mut seen, 0, needle, Duration::from_secs(10));
+    (stream, seen)
+}
+
+/// Read what `stream` sends for `time` (it must stay open).
+fn read_for(stream: &mut TcpStream, seen: &mut Vec<u8>, time: Duration) {
+    let deadline = Instant::now() + time;
+    while Instant::now() < deadline {
+        let mut chunk = [0; 4096];
+        match stream.read(&mut chunk) {
+            Ok(0) => panic!("the stream closed: {:?}", String::from_utf8_lossy(seen)),
+            Ok(n) => seen.extend_from_slice(&chunk[..n]),
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) => {}
+            Err(e) => panic!("{e}"),
+        }
+    }
+}
+
+/// HEAD of the event stream is its head alone, closed at once (HTTP: a HEAD's
+/// answer has no body), and gives its place back: 40 of them in a row, more
+/// than the 32 streams open at once, are each answered. A 33rd open stream
+/// gets 503 until one closes.
+#[test]
+fn event_streams_are_at_most_32_and_head_gives_its_place_back() {
+    let server = Server::start(None);
+    let port = server.port;
+    for n in 0..40 {
+        let (mut stream, mut seen) = open_events(port, "HEAD", "\r\n\r\n");
+        let deadline = Instant::now() + Duration::from_secs(10);
+        loop {
+            let mut chunk = [0; 4096];
+            match stream.read(&mut chunk) {
+                Ok(0) => break,
+                Ok(k) => seen.extend_from_slice(&chunk[..k]),
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                    ) =>
+                {
+                    assert!(Instant::now() < deadline, "HEAD {n}: not closed");
+                }
+                Err(e) => panic!("{e}"),
+            }
+        }
+        let text = String::from_utf8_lossy(&seen);
+        assert!(text.starts_with("HTTP/1.1 200 OK\r\n"), "HEAD {n}: {text}");
+        assert!(text.ends_with("\r\n\r\n"), "HEAD {n}: a body: {text:?}");
+    }
+    let open: Vec<_> = (0..32)
+        .map(|_| open_events(port, "GET", ": connected at version 1\n\n"))
+        .collect();
+    // Read until its head alone: a stream let in never ends.
+    let (_, head) = open_events(port, "GET", "\r\n\r\n");
+    let head = String::from_utf8_lossy(&head).to_string();
+    assert!(head.starts_with("HTTP/1.1 503 "), "a 33rd stream: {head}");
+    assert_eq!(server.get("/api/scene").status, 200);
+    drop(open);
+}
+
+/// An event is a reload: none when the stream opens (the comment says the
+/// version then), one for a change, and no repeats of it.
+#[test]
+fn an_event_stream_tells_each_reload_once() {
+    let (_dir, scene) = scene_folder();
+    let server = Server::start(Some(&scene));
+    let (mut events, mut seen) = open_events(server.port, "GET", ": connected at version 1\n\n");
+    // Two looks of the watcher and more: nothing to tell.
+    read_for(&mut events, &mut seen, Duration::from_millis(700));
+    let text = String::from_utf8_lossy(&seen).to_string();
+    assert!(!text.contains("data:"), "{text}");
+    let mark = seen.len();
+    let seed = raystep::io::scene_file::SEED_TOML;
+    std::fs::write(&scene, seed.replace("radius = 0.7", "radius = 0.5")).unwrap();
+    read_until(
+        &mut events,
+        &mut seen,
+        mark,
+        "data: {\"error\":null,\"version\":2}\n\n",
+        Duration::from_secs(10),
+    );
+    read_for(&mut events, &mut seen, Duration::from_millis(700));
+    let text = String::from_utf8_lossy(&seen[mark..]).to_string();
+    assert_eq!(text.matches("data:").count(), 1, "{text}");
+}
+
+/// Wait (at most 10 s) until the served scene's version is `version`.
+fn wait_for_version(server: &Server, version: u64) -> Value {
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        let json = server.get("/api/scene?objects=none").json();
+        if json["version"] == version {
+            return json;
+        }
+        assert!(Instant::now() < deadline, "still {json}");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// A save that leaves the bytes as they were is no reload, nor is a file
+/// emptied (one being written: no scene is empty); a change is.
+#[test]
+fn the_same_bytes_again_or_an_empty_file_is_no_new_version() {
+    let (_dir, scene) = scene_folder();
+    let server = Server::start(Some(&scene));
+    let seed = raystep::io::scene_file::SEED_TOML;
+    // The same bytes, a new modification time; then an empty file. Each is
+    // given four looks of the watcher (every 250 ms, README).
+    std::fs::write(&scene, seed).unwrap();
+    std::thread::sleep(Duration::from_millis(1000));
+    let json = server.get("/api/scene?objects=none").json();
+    assert_eq!(
+        (&json["version"], &json["error"]),
+        (&1.into(), &Value::Null)
+    );
+    std::fs::write(&scene, "").unwrap();
+    std::thread::sleep(Duration::from_millis(1000));
+    let json = server.get("/api/scene?objects=none").json();
+    assert_eq!(
+        (&json["version"], &json["error"]),
+        (&1.into(), &Value::Null)
+    );
+    // The watcher was looking: a change is version 2.
+    std::fs::write(&scene, seed.replace("radius = 0.7", "radius = 0.5")).unwrap();
+    let json = wait_for_version(&server, 2);
+    assert_eq!(json["error"], Value::Null);
+}
+
+/// The beauty kept for a diff is kept by the scene's version too (README): after
+/// a reload the diff renders again, and the versions it reports are the new one.
+#[test]
+fn a_diff_after_a_reload_renders_the_new_scene() {
+    let (_dir, scene) = scene_folder();
+    let server = Server::start(Some(&scene));
+    let query = "width=60&height=40";
+    assert_eq!(server.get(&format!("/api/render?{query}")).status, 200);
+    let seed = raystep::io::scene_file::SEED_TOML;
+    std::fs::write(&scene, seed.replace("radius = 0.7", "radius = 0.5")).unwrap();
+    wait_for_version(&server, 2);
+    // A against itself: one render of the new scene, none of the old one reused.
+    let side = query.replace('=', "%3D").replace('&', "%26");
+    let reply = server.get(&format!("/api/diff?a={side}&b={side}"));
+    assert_eq!(reply.status, 200);
+    assert_eq!(reply.header("X-Raystep-Renders"), Some("1"));
+    let json = reply.json();
+    assert_eq!(json["a_version"], 2);
+    assert_eq!(json["b_version"], 2);
+}
+
+/// A diff compares renders of one size: a height differing alone is refused as
+/// a width is.
+#[test]
+fn a_diff_of_two_heights_is_400() {
+    let server = Server::start(None);
+    let reply = server.get("/api/diff?a=width%3D60%26height%3D40&b=width%3D60%26height%3D41");
+    assert_eq!(reply.status, 400);
+    assert_eq!(
+        reply.error(),
+        "a is 60 × 40 but b is 60 × 41: only renders of one size compare"
+    );
+}
+
+/// A query is at most 4 KiB (README): 4096 bytes are taken, 4097 are not; and at
+/// most `MAX_QUERY_PAIRS` pairs (empty ones too) are.
+#[test]
+fn a_query_is_at_most_4_kib_and_64_pairs() {
+    use raystep::tools::serve::api::MAX_QUERY_PAIRS;
+    let server = Server::start(None);
+    let pad = |bytes: usize| format!("objects=all{}", "&".repeat(bytes - 11));
+    assert_eq!(server.get(&format!("/api/scene?{}", pad(4096))).status, 200);
+    let long = server.get(&format!("/api/scene?{}", pad(4097)));
+    assert_eq!(long.status, 400);
+    assert!(long.error().contains("4097 bytes"), "{}", long.error());
+    let pairs = |n: usize| vec!["="; n].join("&");
+    let most = server.get(&format!("/api/scene?{}", pairs(MAX_QUERY_PAIRS)));
+    assert_eq!(most.status, 200);
+    let more = server.get(&format!("/api/scene?{}", pairs(MAX_QUERY_PAIRS + 1)));
+    assert_eq!(more.status, 400);
+    assert!(more.error().contains("more than"), "{}", more.error());
+}
+
+/// A view's name is 1 to 64 letters, digits, `-` or `_` (its message says so).
+#[test]
+fn a_views_name_is_1_to_64_characters() {
+    let server = Server::start(None);
+    let view = |n: usize| format!("/api/render?width=8&height=8&view={}", "v".repeat(n));
+    assert_eq!(server.get(&view(1)).status, 200);
+    assert_eq!(server.get(&view(64)).status, 200);
+    for n in [0, 65] {
+        let reply = server.get(&view(n));
+        assert_eq!(reply.status, 400, "{n}");
+        assert!(reply.error().contains("1 to 64"), "{n}: {}", reply.error());
+    }
+}
+
+/// A moved point's numbers are each at most 1e6 in size, negative ones too.
+#[test]
+fn a_moved_point_is_at_most_1e6_each_way() {
+    let server = Server::start(None);
+    for (query, status) in [
+        ("light=-1e6,5,5", 200),
+        ("light=1e6,5,5", 200),
+        ("light=-1000001,5,5", 400),
+        ("camera=0,-1e7,1", 400),
+        ("camera=0,0,-1e9", 400),
+    ] {
+        let reply = server.get(&format!("/api/scene.toml?{query}"));
+        assert_eq!(reply.status, status, "{query}");
+    }
+}
+
+/// The headers the page's drags read: the eye where the scene (or the move)
+/// puts it, as `x,y,z`, and the screen as `left,right,top,bottom`, which for a
+/// scene without one is the tutorial's, from the image's ratio: −1 to 1 across,
+/// ±height/width up and down (README, "JSON output": `screen`).
+#[test]
+fn the_camera_and_screen_headers_are_in_their_documented_order() {
+    let server = Server::start(None);
+    let numbers = |reply: &Reply, name: &str| -> Vec<f64> {
+        reply
+            .header(name)
+            .unwrap()
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect()
+    };
+    let plain = server.get("/api/render?width=30&height=20");
+    assert_eq!(numbers(&plain, "X-Raystep-Camera"), [0.0, 0.0, 1.0]);
+    assert_eq!(
+        numbers(&plain, "X-Raystep-Screen"),
+        [-1.0, 1.0, 20.0 / 30.0, -20.0 / 30.0]
+    );
+    let moved = server.get("/api/render?width=30&height=20&camera=0.25,-0.1,0.5");
+    assert_eq!(numbers(&moved, "X-Raystep-Camera"), [0.25, -0.1, 0.5]);
+}
+
+/// Every answer is one block with its length (`Content-Length`, never chunked),
+/// a large PNG too: more than tiny_http's own threshold for chunks (32 KiB).
+#[test]
+fn a_large_answer_comes_with_its_length() {
+    let server = Server::start(None);
+    for target in [
+        "/api/render?width=600&height=400&buffer=normal",
+        "/api/scene",
+    ] {
+        let reply = server.get(target);
+        assert_eq!(reply.status, 200);
+        assert_eq!(reply.header("Transfer-Encoding"), None, "{target}");
+        assert_eq!(
+            reply.header("Content-Length"),
+            Some(reply.body.len().to_string().as_str()),
+            "{target}"
+        );
+    }
+    let png = server.get("/api/render?width=600&height=400&buffer=normal");
+    assert!(png.body.len() > 32 * 1024, "{} bytes", png.body.len());
+}
+
 /// Keys of the query: the flags, a few others, and anything.
 fn key() -> impl Strategy<Value = String> {
     prop_oneof![
