@@ -550,7 +550,7 @@ fn generate_writes_a_million_spheres_as_their_recipe_and_the_recipe_loads() {
 }
 
 #[test]
-fn chart_writes_its_csv_svg_and_png() {
+fn chart_writes_its_csv_svg_and_png_and_its_errors_rank_the_settings_as_chapter_10_says() {
     let dir = tempfile::tempdir().unwrap();
     let out = raystep(
         dir.path(),
@@ -565,24 +565,12 @@ fn chart_writes_its_csv_svg_and_png() {
     assert!(std::fs::read_to_string(dir.path().join("c/chart.svg"))
         .unwrap()
         .starts_with("<svg"));
-}
-
-/// The chart's numbers say what chapter 10 says of them: one row, `default`, is
-/// raystep's default; more samples divide the error (16 below 4 below 1); a
-/// `max_depth` of 1 misses reflections that 2 already has; float32 moves pixels;
-/// acceleration, early stop and the book engine change none (the default's error
-/// exactly); and no pixel's error is below the root mean square of them all.
-#[test]
-fn the_charts_errors_rank_the_settings_as_chapter_10_describes() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = raystep(
-        dir.path(),
-        &[
-            "chart", "--width", "32", "--height", "18", "--runs", "1", "--out", "c",
-        ],
-    );
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let csv = std::fs::read_to_string(dir.path().join("c/chart.csv")).unwrap();
+    // The numbers say what chapter 10 says of them: one row, `default`, is
+    // raystep's default; more samples divide the error (16 below 4 below 1); a
+    // `max_depth` of 1 misses reflections that 2 already has; float32 moves
+    // pixels; acceleration, early stop and the book engine change none (the
+    // default's error exactly); and no pixel's error is below the root mean
+    // square of them all.
     let mut reader = csv::Reader::from_reader(csv.as_bytes());
     let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
     let row = |setting: &str| {

@@ -965,6 +965,22 @@ fn paths_that_leave_the_page_are_404() {
     }
 }
 
+/// Read what `stream` has sent into `seen`, if anything came before its read
+/// timeout; fail if it closed.
+fn read_some(stream: &mut TcpStream, seen: &mut Vec<u8>) {
+    let mut chunk = [0; 4096];
+    match stream.read(&mut chunk) {
+        Ok(0) => panic!("the stream closed: {:?}", String::from_utf8_lossy(seen)),
+        Ok(n) => seen.extend_from_slice(&chunk[..n]),
+        Err(e)
+            if matches!(
+                e.kind(),
+                std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+            ) => {}
+        Err(e) => panic!("{e}"),
+    }
+}
+
 /// Read from `stream` into `seen` until it holds `needle` after `from`, or fail
 /// after `timeout`.
 fn read_until(
@@ -983,17 +999,7 @@ fn read_until(
             "no {needle:?} in {:?}",
             String::from_utf8_lossy(seen)
         );
-        let mut chunk = [0; 4096];
-        match stream.read(&mut chunk) {
-            Ok(0) => panic!("the stream closed: {:?}", String::from_utf8_lossy(seen)),
-            Ok(n) => seen.extend_from_slice(&chunk[..n]),
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) => {}
-            Err(e) => panic!("{e}"),
-        }
+        read_some(stream, seen);
     }
 }
 
@@ -1385,17 +1391,7 @@ fn open_events(port: u16, method: &str, needle: &str) -> (TcpStream, Vec<u8>) {
 fn read_for(stream: &mut TcpStream, seen: &mut Vec<u8>, time: Duration) {
     let deadline = Instant::now() + time;
     while Instant::now() < deadline {
-        let mut chunk = [0; 4096];
-        match stream.read(&mut chunk) {
-            Ok(0) => panic!("the stream closed: {:?}", String::from_utf8_lossy(seen)),
-            Ok(n) => seen.extend_from_slice(&chunk[..n]),
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) => {}
-            Err(e) => panic!("{e}"),
-        }
+        read_some(stream, seen);
     }
 }
 
