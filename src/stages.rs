@@ -264,4 +264,26 @@ mod tests {
         assert_eq!(folders[3], "04-blinn-phong");
         assert_eq!(folders[5], "06-plane");
     }
+
+    /// Every stage after `intersection` needs the hit point intersection finds,
+    /// even when it is the only one left on beside `rays`: `--stage S --without
+    /// intersection --without` every stage between is refused, naming S.
+    #[test]
+    fn each_stage_after_intersection_alone_is_refused_without_intersection() {
+        let later = [
+            Stage::Shadow,
+            Stage::BlinnPhong,
+            Stage::Reflection,
+            Stage::Plane,
+        ];
+        for (i, &stage) in later.iter().enumerate() {
+            let mut without = vec![Stage::Intersection];
+            without.extend_from_slice(&later[..i]);
+            let err = Stages::select(stage, &without).unwrap_err();
+            assert!(
+                err.contains(&format!("`{stage}` cannot run without `intersection`")),
+                "{stage}: {err}"
+            );
+        }
+    }
 }

@@ -707,6 +707,102 @@ fn diff_places_the_largest_difference_at_its_row_and_column() {
     }
 }
 
+/// `over_threshold_percent` is a percentage of the pixels (README: "the same as
+/// a percentage of `pixels`"), and `--fail-percent P` lets up to P percent
+/// differ: two 30 × 20 pictures (600 pixels) that differ in 3 pixels by 0.5
+/// differ in 0.5 % of them, different under `--fail-percent 0.4`, the same under
+/// 0.5 (at most 0.5 %) and 0.6.
+#[test]
+fn diff_gives_the_share_of_differing_pixels_in_percent_and_fails_above_fail_percent() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, changed) in [("a.exr", false), ("b.exr", true)] {
+        exr::prelude::write_rgb_file(dir.path().join(name), 30, 20, |col, row| {
+            let differs = changed && [(0, 0), (7, 11), (19, 29)].contains(&(row, col));
+            (if differs { 0.75 } else { 0.25f32 }, 0.25f32, 0.25f32)
+        })
+        .unwrap();
+    }
+    let json = raystep(dir.path(), &["diff", "a.exr", "b.exr", "--json"]);
+    let report: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    assert_eq!(report["over_threshold"], 3, "{report}");
+    let percent = report["over_threshold_percent"].as_f64().unwrap();
+    assert!((percent - 0.5).abs() < 1e-9, "{report}");
+    let said = raystep(dir.path(), &["diff", "a.exr", "b.exr"]);
+    assert!(
+        text(&said.stdout).contains("different: 3 pixels (0.50 %) differ by more than"),
+        "{}",
+        text(&said.stdout)
+    );
+    for (allowed, code) in [("0.4", 1), ("0.5", 0), ("0.6", 0)] {
+        let out = raystep(
+            dir.path(),
+            &["diff", "a.exr", "b.exr", "--fail-percent", allowed],
+        );
+        assert_eq!(out.status.code(), Some(code), "--fail-percent {allowed}");
+    }
+}
+
+/// `non_finite` counts the pixels with a channel infinite or NaN in `a`, then in
+/// `b`, as `clipped` does: a has a NaN and an infinity in two pixels, b an
+/// infinity in a third; swapping the files swaps the counts.
+#[test]
+fn diff_counts_the_pixels_not_finite_in_a_then_in_b() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, odd: &[((usize, usize), f32)]| {
+        exr::prelude::write_rgb_file(dir.path().join(name), 4, 3, |col, row| {
+            let red = odd
+                .iter()
+                .find(|(at, _)| *at == (row, col))
+                .map_or(0.5, |&(_, v)| v);
+            (red, 0.5f32, 0.5f32)
+        })
+        .unwrap();
+    };
+    write("a.exr", &[((0, 1), f32::NAN), ((2, 3), f32::INFINITY)]);
+    write("b.exr", &[((1, 0), f32::INFINITY)]);
+    for (a, b, counts) in [("a.exr", "b.exr", [2, 1]), ("b.exr", "a.exr", [1, 2])] {
+        let json = raystep(dir.path(), &["diff", a, b, "--json"]);
+        let report: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+        assert_eq!(report["non_finite"], serde_json::json!(counts), "{report}");
+        assert_eq!(report["over_threshold"], 3, "{report}");
+        let said = raystep(dir.path(), &["diff", a, b]);
+        assert!(
+            text(&said.stdout).contains(&format!(
+                "not finite (inf or NaN):   {} and {} pixels",
+                counts[0], counts[1]
+            )),
+            "{}",
+            text(&said.stdout)
+        );
+    }
+}
+
+/// README: `generate spheres` lists "up to 100,000" spheres one by one and
+/// writes the recipe above: 100,000 are listed, with nothing said on stderr;
+/// 100,001 are a recipe, and stderr says so.
+#[test]
+fn generate_lists_100000_spheres_and_writes_the_recipe_of_100001() {
+    let dir = tempfile::tempdir().unwrap();
+    let listed = raystep(dir.path(), &["generate", "spheres", "--count", "100000"]);
+    assert_eq!(listed.status.code(), Some(0), "{}", text(&listed.stderr));
+    assert!(listed.stderr.is_empty(), "{}", text(&listed.stderr));
+    let file = text(&listed.stdout);
+    assert_eq!(file.matches("[[sphere]]\n").count(), 100_000);
+    assert!(!file.contains("[generate]"));
+    let recipe = raystep(dir.path(), &["generate", "spheres", "--count", "100001"]);
+    assert_eq!(recipe.status.code(), Some(0), "{}", text(&recipe.stderr));
+    let file = text(&recipe.stdout);
+    assert!(
+        file.contains("[generate]\nspheres = 100001\nseed = 1\n") && !file.contains("[[sphere]]"),
+        "{file}"
+    );
+    assert!(
+        text(&recipe.stderr).contains("recipe"),
+        "{}",
+        text(&recipe.stderr)
+    );
+}
+
 /// Issue 22's bound: a 1920 × 1080 render with every buffer (twelve pictures
 /// and the EXR of 26 channels) peaks at or under 150 MB (10⁶ bytes), as
 /// `render --json` reports it from `/proc` (125.8 MB with a release build on

@@ -202,4 +202,41 @@ mod tests {
         let d = compare(&[[f32::NAN; 3]], &[[f32::NAN; 3]], 1);
         assert_eq!((d.over_one_step, d.non_finite), (0, (1, 1)));
     }
+
+    /// "More than 1/255": a channel off by exactly one 8-bit step (the float32
+    /// nearest 1/255, against 0) does not count, one off by two steps does.
+    #[test]
+    fn a_difference_of_exactly_one_step_is_not_over_one_step() {
+        let step = 1.0f32 / 255.0;
+        let a = [[step, 0.0, 0.0], [0.0, 2.0 * step, 0.0]];
+        let b = [[0.0; 3], [0.0; 3]];
+        let d = compare(&a, &b, 2);
+        assert_eq!(d.over_one_step, 1, "only the pixel two steps off");
+        assert_eq!(pixels_over(&a, &b, step), 1);
+        assert_eq!(
+            pixels_over(&a, &b, 2.0 * step),
+            0,
+            "at the threshold, not over it"
+        );
+    }
+
+    /// README: `largest_at` is "row 0, column 0 when nothing differs", whatever
+    /// the size of the images.
+    #[test]
+    fn two_equal_images_place_the_largest_difference_at_row_0_column_0() {
+        let a = [[0.25, 0.5, 0.75]; 6];
+        let d = compare(&a, &a, 3);
+        assert_eq!((d.largest, d.largest_at), (0.0, (0, 0)));
+    }
+
+    /// README: the RMSE is "over the channels finite in both files". Two pixels,
+    /// one with a NaN in red: five channels finite in both, one of them 0.3 apart,
+    /// so the RMSE is √(0.09 / 5) = 0.134164…, not √(0.09 / 6) = 0.122474….
+    #[test]
+    fn the_root_mean_square_is_over_the_channels_finite_in_both_images() {
+        let a = [[f32::NAN, 0.0, 0.0], [0.3, 0.0, 0.0]];
+        let b = [[0.0; 3], [0.0; 3]];
+        let d = compare(&a, &b, 2);
+        assert!((d.rmse - 0.134_164_08).abs() < 1e-6, "{}", d.rmse);
+    }
 }
