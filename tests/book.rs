@@ -5,6 +5,7 @@
 
 mod common;
 
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use raystep::tools::cli::render_command;
@@ -1007,4 +1008,79 @@ fn the_studio_screenshots_are_those_the_browser_test_recorded() {
             (size.0.into(), size.1.into())
         );
     }
+}
+
+/// Every image under `dir`, as paths relative to it.
+fn images_under(dir: &Path) -> BTreeSet<String> {
+    let mut found = BTreeSet::new();
+    let mut folders = vec![dir.to_path_buf()];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).unwrap().flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                folders.push(path);
+            } else if path.extension().is_some_and(|e| e == "png" || e == "svg") {
+                let relative = path.strip_prefix(dir).unwrap();
+                found.insert(relative.to_string_lossy().replace('\\', "/"));
+            }
+        }
+    }
+    found
+}
+
+/// `raystep figures` writes the files the book links, by the names committed in
+/// chapters/img/ (whatever the renderer, here one of thumbnails), and `--check`
+/// finds nothing to say of what it wrote, but reports a figure whose bytes
+/// differ at the same length, a missing one, and an image nothing makes.
+#[test]
+fn figures_writes_the_committed_names_and_check_reports_each_kind_of_problem() {
+    use raystep::tools::figures::write_all;
+    let small =
+        |args: &str, root: &Path| render_command(&format!("{args} --width 8 --height 6"), root);
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("img");
+    let written = write_all(&root(), &out, &small).unwrap();
+    assert_eq!(written.len(), images_under(&out).len(), "each file once");
+    // Every image in chapters/img/ is one `raystep figures` makes: the same
+    // names, no more, no fewer.
+    assert_eq!(
+        images_under(&out),
+        images_under(&root().join("chapters/img"))
+    );
+    assert_eq!(
+        check_all(&root(), &out, &small).unwrap(),
+        Vec::<String>::new()
+    );
+
+    // One byte changed, the length kept: the last byte of a PNG (its IEND CRC).
+    let changed = out.join("ch04/acne-shadow.png");
+    let mut bytes = std::fs::read(&changed).unwrap();
+    *bytes.last_mut().unwrap() ^= 1;
+    std::fs::write(&changed, bytes).unwrap();
+    std::fs::remove_file(out.join("ch01/seed-beauty.png")).unwrap();
+    std::fs::write(out.join("ch01/stray.png"), b"not a figure").unwrap();
+    let problems = check_all(&root(), &out, &small).unwrap();
+    assert_eq!(problems.len(), 3, "{problems:#?}");
+    assert!(
+        problems[0].starts_with("ch01/seed-beauty.png: missing")
+            && problems[1].starts_with("ch04/acne-shadow.png: differs")
+            && problems[2].contains("stray.png: no figure or diagram makes this image"),
+        "{problems:#?}"
+    );
+}
+
+/// A figure is encoded as its command's `--png` says: sRGB for the one command
+/// that asks for it, linear for every other.
+#[test]
+fn each_figure_is_encoded_as_its_command_says() {
+    use raystep::io::output::PngEncoding;
+    for figure in FIGURES {
+        let expected = if figure.args.contains("--png srgb") {
+            PngEncoding::Srgb
+        } else {
+            PngEncoding::Linear
+        };
+        assert_eq!(figure.png(), expected, "{}", figure.name);
+    }
+    assert!(FIGURES.iter().any(|f| f.png() == PngEncoding::Srgb));
 }

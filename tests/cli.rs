@@ -491,6 +491,86 @@ fn bench_prints_one_json_object_with_the_promised_keys() {
     );
 }
 
+/// `bench --json`'s derived figures are the quotients README.md defines them by,
+/// each of the very times it names (a ratio inverted, or taken against another
+/// run's time, breaks one), `runs` is the count asked for, and the yardstick's rays
+/// are the rays of the tutorial's own render of the same frame (chapter 10: it
+/// traces the same rays), not the fast engine's.
+#[test]
+fn bench_json_derives_each_ratio_from_the_times_it_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = |args: &[&str]| -> serde_json::Value {
+        let out = raystep(dir.path(), args);
+        assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let bench = json(&[
+        "bench",
+        "--width",
+        "20",
+        "--height",
+        "12",
+        "--runs",
+        "3",
+        "--threads",
+        "2",
+        "--json",
+    ]);
+    let get = |key: &str| {
+        bench[key]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{key} in {bench}"))
+    };
+    assert_eq!(bench["runs"].as_u64(), Some(3), "{bench}");
+    assert_eq!(bench["threads"].as_u64(), Some(2), "{bench}");
+    // (field, numerator, denominator), as README.md and the report's fields say.
+    for (key, over, under) in [
+        ("thread_speedup", "one_thread_median_s", "median_s"),
+        ("trace_thread_speedup", "one_thread_trace_s", "trace_s"),
+        ("yardstick_ratio", "yardstick_median_s", "median_s"),
+        (
+            "other_yardstick_ratio",
+            "yardstick_median_s",
+            "other_median_s",
+        ),
+        ("rays_per_s", "rays", "median_s"),
+        ("trace_rays_per_s", "rays", "trace_s"),
+        (
+            "yardstick_rays_per_s",
+            "yardstick_rays",
+            "yardstick_median_s",
+        ),
+    ] {
+        let expected = get(over) / get(under);
+        assert!(
+            (get(key) - expected).abs() <= 1e-9 * expected.abs(),
+            "{key} = {} is not {over} / {under} = {expected}: {bench}",
+            get(key)
+        );
+    }
+    let pixels = 20.0 * 12.0 / get("median_s");
+    assert!(
+        (get("pixels_per_s") - pixels).abs() <= 1e-9 * pixels,
+        "{bench}"
+    );
+    // The tutorial's render of the same frame counts its rays pixel by pixel.
+    let tutorial = json(&[
+        "render",
+        "--tutorial",
+        "--width",
+        "20",
+        "--height",
+        "12",
+        "-o",
+        "t",
+        "--json",
+    ]);
+    assert_eq!(
+        bench["yardstick_rays"], tutorial["rays"]["total"],
+        "{bench} against {tutorial}"
+    );
+}
+
 #[test]
 fn generate_writes_a_scene_that_loads_and_refuses_a_count_of_zero() {
     let dir = tempfile::tempdir().unwrap();

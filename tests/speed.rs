@@ -417,6 +417,68 @@ fn the_yardstick_counts_the_rays_the_tutorials_program_casts() {
     assert_eq!(port.render_into(&mut Vec::new(), &mut Vec::new()), 139_471);
 }
 
+/// The tutorial's rule for a hit: both roots of the quadratic positive. From
+/// inside a sphere one root is negative, so the tutorial's program sees nothing of
+/// a sphere around the camera: every pixel that misses the small sphere inside is
+/// black and cast its primary ray only, and the whole picture and every count are
+/// the book engine's under `--tutorial`. (A scene file cannot put the camera
+/// inside a sphere; the library's `Scene` can, and the port keeps the rule.)
+#[test]
+fn the_yardstick_sees_nothing_of_a_sphere_around_the_camera() {
+    let mut scene = raystep::io::scene_file::parse(
+        "[image]\nwidth = 40\nheight = 30\n[camera]\nposition = [0, 0, 9]\n\
+         [light]\nposition = [0, 9, 9]\n[render]\nmax_depth = 3\n\
+         [[sphere]]\ncenter = [0, 0, 0]\nradius = 5\n\
+         ambient = [0.1, 0.1, 0.1]\ndiffuse = [0.6, 0.6, 0.6]\n\
+         [[sphere]]\ncenter = [0, 0, -1]\nradius = 0.5\n\
+         ambient = [0.1, 0, 0]\ndiffuse = [0.7, 0, 0]\n",
+        "around.toml",
+    )
+    .unwrap();
+    scene.camera = glam::DVec3::new(0.0, 0.0, 1.0);
+    scene.light.position = glam::DVec3::new(0.0, 1.0, 1.0);
+    let port = Yardstick::new(&scene).expect("only spheres");
+    let (mut image, mut rays) = (Vec::new(), Vec::new());
+    let total = port.render_into(&mut image, &mut rays);
+    let ours = render(&scene, &Settings::tutorial(Stages::ALL), &|_| {});
+    let mut missed = 0;
+    for (i, ((colour, r), p)) in image.iter().zip(&rays).zip(&ours.pixels).enumerate() {
+        assert_eq!(colour.as_vec3().to_array(), p.colour, "pixel {i}");
+        assert_eq!(*r, p.rays, "pixel {i}");
+        if p.object == raystep::aov::NO_OBJECT {
+            missed += 1;
+            assert_eq!(
+                *colour,
+                glam::DVec3::ZERO,
+                "pixel {i} sees the sphere around it"
+            );
+            assert_eq!(*r, 1, "pixel {i}");
+        }
+    }
+    assert!(missed > 0 && missed < 40 * 30, "{missed} pixels miss");
+    assert_eq!(total, ours.rays.total());
+}
+
+/// `raystep bench` renders every measurement once to warm up, then `runs`
+/// times: its progress hears of `runs + 1` runs, and the report says `runs`.
+#[test]
+fn bench_runs_one_warm_up_then_the_runs_asked_for() {
+    use raystep::tools::bench::{bench, Options};
+    let scene = common::seed(8, 6);
+    let settings = Settings::from(Stages::ALL);
+    for runs in [1, 2, 4] {
+        let heard = Cell::new(0);
+        let options = Options {
+            runs,
+            threads: 2,
+            yardstick: true,
+        };
+        let report = bench(&scene, &settings, options, &|n| heard.set(heard.get() + n)).unwrap();
+        assert_eq!(heard.get(), runs as u64 + 1, "{runs} runs");
+        assert_eq!(report.runs, runs);
+    }
+}
+
 #[test]
 fn the_yardstick_refuses_a_true_plane() {
     assert!(Yardstick::new(&load("scenes/true-plane.toml", 10, 10)).is_none());

@@ -440,4 +440,18 @@ mod tests {
         assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), 2.5);
         assert!(median(vec![]).is_nan());
     }
+
+    /// The row clock keeps the rows' time of every frame but the first, the
+    /// warm-up: three frames, two times.
+    #[test]
+    fn the_row_clock_leaves_out_the_warm_up_frame() {
+        let clock = RowClock::default();
+        for _ in 0..3 {
+            clock.rows_begin();
+            clock.rows_end();
+        }
+        // A frame whose rows never began (an interrupted one) adds no time.
+        clock.rows_end();
+        assert_eq!(clock.timed().len(), 2);
+    }
 }

@@ -174,3 +174,25 @@ impl Yardstick {
         (colour.clamp(DVec3::ZERO, DVec3::ONE), rays)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The port's pixel centres are numpy's `linspace`: the last one is the
+    /// screen's edge exactly, even where `a + (n - 1) · step` rounds past it
+    /// (`-1 + 98 · (2 / 98)` is not 1 in float64, nor is the height's sum at 49).
+    #[test]
+    fn the_pixel_centres_end_exactly_at_the_screens_edges() {
+        assert_ne!(-1.0 + 98.0 * (2.0 / 98.0), 1.0);
+        let mut scene = crate::io::scene_file::seed();
+        (scene.width, scene.height) = (99, 49);
+        let port = Yardstick::new(&scene).unwrap();
+        let top = 1.0 / (99.0 / 49.0);
+        assert_eq!(port.xs.len(), 99);
+        assert_eq!((port.xs[0], port.xs[98]), (-1.0, 1.0));
+        assert_eq!(port.xs[1], -1.0 + 2.0 / 98.0);
+        assert_eq!(port.ys.len(), 49);
+        assert_eq!((port.ys[0], port.ys[48]), (top, -top));
+    }
+}
