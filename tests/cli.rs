@@ -12,7 +12,16 @@ fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
-fn png_size(path: &Path) -> (u32, u32) {
+/// Run raystep in `dir` with `args`, which must succeed, and read the JSON it
+/// prints.
+fn json_of(dir: &Path, args: &[&str]) -> serde_json::Value {
+    let out = raystep(dir, args);
+    assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{args:?}: {e}"))
+}
+
+/// The bytes of the PNG file at `path` (its signature checked).
+fn png_file(path: &Path) -> Vec<u8> {
     let bytes = std::fs::read(path).unwrap();
     assert_eq!(
         &bytes[..8],
@@ -20,6 +29,11 @@ fn png_size(path: &Path) -> (u32, u32) {
         "{} is a PNG",
         path.display()
     );
+    bytes
+}
+
+fn png_size(path: &Path) -> (u32, u32) {
+    let bytes = png_file(path);
     let be = |i: usize| u32::from_be_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
     (be(16), be(20))
 }
@@ -499,11 +513,7 @@ fn bench_prints_one_json_object_with_the_promised_keys() {
 #[test]
 fn bench_json_derives_each_ratio_from_the_times_it_names() {
     let dir = tempfile::tempdir().unwrap();
-    let json = |args: &[&str]| -> serde_json::Value {
-        let out = raystep(dir.path(), args);
-        assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
-        serde_json::from_slice(&out.stdout).unwrap()
-    };
+    let json = |args: &[&str]| json_of(dir.path(), args);
     let bench = json(&[
         "bench",
         "--width",
@@ -859,7 +869,7 @@ fn diff_counts_the_pixels_not_finite_in_a_then_in_b() {
 
 /// README: `generate spheres` lists "up to 100,000" spheres one by one and
 /// writes the recipe above: 100,000 are listed, with nothing said on stderr;
-/// 100,001 are a recipe, and stderr says so.
+/// 100,001 are a recipe, and stderr says so (but not under `-q`).
 #[test]
 fn generate_lists_100000_spheres_and_writes_the_recipe_of_100001() {
     let dir = tempfile::tempdir().unwrap();
@@ -881,6 +891,14 @@ fn generate_lists_100000_spheres_and_writes_the_recipe_of_100001() {
         "{}",
         text(&recipe.stderr)
     );
+    // `-q` silences that note too; the scene still goes to standard output.
+    let quiet = raystep(
+        dir.path(),
+        &["-q", "generate", "spheres", "--count", "100001"],
+    );
+    assert_eq!(quiet.status.code(), Some(0), "{}", text(&quiet.stderr));
+    assert_eq!(text(&quiet.stderr), "");
+    assert_eq!(text(&quiet.stdout), file);
 }
 
 /// Issue 22's bound: a 1920 × 1080 render with every buffer (twelve pictures
@@ -1429,4 +1447,214 @@ fn each_exr_compression_writes_the_scheme_openexr_names() {
         assert_eq!(header.compression.scan_lines_per_block(), lines);
         assert_eq!(header.chunk_count, 40usize.div_ceil(lines), "{name}");
     }
+}
+
+/// The chunk types of a PNG file, in order (README: `--png srgb` writes an
+/// `sRGB` chunk, `linear` none).
+fn png_chunks(path: &Path) -> Vec<String> {
+    let bytes = png_file(path);
+    let mut chunks = Vec::new();
+    let mut at = 8;
+    while at + 8 <= bytes.len() {
+        let length = u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        chunks.push(String::from_utf8_lossy(&bytes[at + 4..at + 8]).into_owned());
+        at += 12 + length; // length, type, data, CRC
+    }
+    chunks
+}
+
+/// The compression a `buffers.exr` file's header names.
+fn exr_compression(path: &Path) -> exr::compression::Compression {
+    let meta = exr::meta::MetaData::read_from_file(path, false)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    meta.headers[0].compression
+}
+
+/// README: without `--out`, `render` and `stages` write into `out/`; `--output
+/// DIR` and `-o DIR` are aliases of `--out DIR`, on `stages` as on `render`.
+#[test]
+fn the_output_folder_is_out_unless_given_and_stages_takes_both_aliases() {
+    let dir = tempfile::tempdir().unwrap();
+    let size = ["--width", "12", "--height", "8", "-q"];
+    let out = raystep(dir.path(), &[&["render"][..], &size].concat());
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(png_size(&dir.path().join("out/beauty.png")), (12, 8));
+    let out = raystep(dir.path(), &[&["stages"][..], &size].concat());
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(
+        png_size(&dir.path().join("out/06-plane/beauty.png")),
+        (12, 8)
+    );
+    for (flag, folder) in [("-o", "short"), ("--output", "long")] {
+        let out = raystep(dir.path(), &[&["stages", flag, folder][..], &size].concat());
+        assert!(out.status.success(), "stages {flag}: {}", text(&out.stderr));
+        let beauty = dir.path().join(folder).join("01-rays/beauty.png");
+        assert_eq!(png_size(&beauty), (12, 8), "stages {flag}");
+    }
+}
+
+/// The README's table of rules: raystep's defaults are f64, stable, auto, the
+/// camera as the viewer, early stop on (and one sample per pixel); `--tutorial`
+/// sets every option to the tutorial's (f64, naive, fixed:1e-5, camera, early
+/// stop off); flags given beside it still apply. `explain --json` states the
+/// rules in force (`rules`), so each of the five shows.
+#[test]
+fn tutorial_sets_all_five_rules_and_flags_beside_it_still_apply() {
+    let dir = tempfile::tempdir().unwrap();
+    let rules = |flags: &[&str]| -> String {
+        let args = [&["explain", "--pixel", "150,100", "--json"][..], flags].concat();
+        let out = raystep(dir.path(), &args);
+        assert!(out.status.success(), "{flags:?}: {}", text(&out.stderr));
+        let story: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        story["rules"].as_str().unwrap().to_string()
+    };
+    assert_eq!(
+        rules(&[]),
+        "precision f64, intersection stable, offset auto, viewer camera, early stop on, \
+         1 sample per pixel"
+    );
+    assert_eq!(
+        rules(&["--tutorial"]),
+        "precision f64, intersection naive, offset fixed:1e-5, viewer camera, \
+         early stop off, 1 sample per pixel"
+    );
+    assert_eq!(
+        rules(&[
+            "--tutorial",
+            "--precision",
+            "f32",
+            "--intersect",
+            "stable",
+            "--offset",
+            "scene",
+            "--viewer",
+            "ray-origin",
+            "--early-stop",
+            "on",
+            "--spp",
+            "4",
+        ]),
+        "precision f32, intersection stable, offset scene, viewer ray origin, \
+         early stop on, 4 samples per pixel"
+    );
+    // `fixed:0` is a valid offset (README: it shows shadow acne).
+    assert!(
+        rules(&["--offset", "fixed:0"]).contains(", offset fixed:0, "),
+        "fixed:0"
+    );
+}
+
+/// `render --json` states what the flags asked for: by default every stage
+/// (README: `--stage` defaults to `plane`, all of them), the book engine and one
+/// sample per pixel; `--engine fast --spp 4 --max-depth 1` is the fast engine,
+/// 4 samples per pixel and the centre ray that gives the buffers (chapter 10:
+/// "one more path per pixel"), 5 primary rays a pixel, and no reflected ray at
+/// all (a path of one segment).
+#[test]
+fn render_json_states_the_stages_engine_samples_and_depth_the_flags_ask_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = |flags: &[&str]| {
+        let render = ["render", "--width", "12", "--height", "8", "-q", "--json"];
+        json_of(dir.path(), &[&render[..], flags].concat())
+    };
+    let plain = json(&[]);
+    assert_eq!(
+        plain["stages"], "rays+intersection+shadow+blinn-phong+reflection+plane",
+        "{plain}"
+    );
+    assert_eq!(plain["engine"], "book", "{plain}");
+    assert_eq!(plain["spp"], 1, "{plain}");
+    assert_eq!(plain["rays"]["primary"], 12 * 8, "{plain}");
+    assert!(plain["rays"]["reflection"].as_u64() > Some(0), "{plain}");
+    let asked = json(&["--engine", "fast", "--spp", "4", "--max-depth", "1"]);
+    assert_eq!(asked["engine"], "fast", "{asked}");
+    assert_eq!(asked["spp"], 4, "{asked}");
+    assert_eq!(asked["rays"]["primary"], (4 + 1) * 12 * 8, "{asked}");
+    assert_eq!(asked["rays"]["reflection"], 0, "{asked}");
+}
+
+/// README: `--png` defaults to `linear` (a PNG with no colour chunk) and
+/// `--exr-compression` to `none`; `--png srgb` adds an `sRGB` chunk, and both
+/// flags work on `stages` as on `render`.
+#[test]
+fn png_and_exr_defaults_and_their_flags_on_render_and_stages() {
+    use exr::compression::Compression;
+    let dir = tempfile::tempdir().unwrap();
+    let size = ["--width", "12", "--height", "8", "-q"];
+    let out = raystep(
+        dir.path(),
+        &[&["render", "-o", "plain"][..], &size].concat(),
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let plain = dir.path().join("plain");
+    assert!(!png_chunks(&plain.join("beauty.png")).contains(&"sRGB".to_string()));
+    assert_eq!(
+        exr_compression(&plain.join("buffers.exr")),
+        Compression::Uncompressed
+    );
+    let out = raystep(
+        dir.path(),
+        &[&["render", "-o", "srgb", "--png", "srgb"][..], &size].concat(),
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let chunks = png_chunks(&dir.path().join("srgb/beauty.png"));
+    assert!(chunks.contains(&"sRGB".to_string()), "{chunks:?}");
+
+    let flags = ["--png", "srgb", "--exr-compression", "zip"];
+    let out = raystep(
+        dir.path(),
+        &[&["stages", "-o", "st"][..], &flags, &size].concat(),
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    for stage in ["01-rays", "06-plane"] {
+        let folder = dir.path().join("st").join(stage);
+        let chunks = png_chunks(&folder.join("beauty.png"));
+        assert!(chunks.contains(&"sRGB".to_string()), "{stage}: {chunks:?}");
+        assert_eq!(
+            exr_compression(&folder.join("buffers.exr")),
+            Compression::ZIP16,
+            "{stage}"
+        );
+    }
+}
+
+/// README: `completions SHELL` writes a script for that shell, in its own
+/// syntax: bash's `complete -F`, zsh's `#compdef` line, fish's `complete -c`,
+/// elvish's `arg-completer` and PowerShell's `Register-ArgumentCompleter`.
+#[test]
+fn completions_are_written_in_each_shells_own_syntax() {
+    let dir = tempfile::tempdir().unwrap();
+    for (shell, mark) in [
+        ("bash", "complete -F _raystep"),
+        ("zsh", "#compdef raystep"),
+        ("fish", "complete -c raystep"),
+        ("elvish", "edit:completion:arg-completer[raystep]"),
+        (
+            "powershell",
+            "Register-ArgumentCompleter -Native -CommandName 'raystep'",
+        ),
+    ] {
+        let out = raystep(dir.path(), &["completions", shell]);
+        assert!(out.status.success(), "{shell}: {}", text(&out.stderr));
+        let script = text(&out.stdout);
+        assert!(script.contains(mark), "{shell}: {script}");
+    }
+}
+
+/// README: `--engine fast` is the default of `bench` (it measures speed), and
+/// `--engine book` still picks the book's engine there; `bench --json` names the
+/// engine timed (`engine`) and the other one (`other_engine`).
+#[test]
+fn bench_times_the_fast_engine_unless_the_book_is_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let bench = |flags: &[&str]| {
+        let bench = ["bench", "--width", "8", "--height", "6", "--runs", "1"];
+        let quiet = ["--no-yardstick", "--json", "-q"];
+        json_of(dir.path(), &[&bench[..], &quiet, flags].concat())
+    };
+    let default = bench(&[]);
+    assert_eq!(default["engine"], "fast", "{default}");
+    assert_eq!(default["other_engine"], "book", "{default}");
+    let book = bench(&["--engine", "book"]);
+    assert_eq!(book["engine"], "book", "{book}");
 }
