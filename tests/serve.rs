@@ -1395,12 +1395,13 @@ fn read_for(stream: &mut TcpStream, seen: &mut Vec<u8>, time: Duration) {
     }
 }
 
-/// HEAD of the event stream is its head alone, closed at once (HTTP: a HEAD's
-/// answer has no body), and gives its place back: 40 of them in a row, more
-/// than the 32 streams open at once, are each answered. A 33rd open stream
-/// gets 503 until one closes.
+/// HEAD of the event stream is its head alone, closed at once when the client
+/// asks (HTTP: a HEAD's answer has no body), and opens no stream: 40 of them in
+/// a row, more than the 32 streams open at once, are each answered. Without
+/// `Connection: close` the connection stays open for the next request, and the
+/// head does not say it closes. A 33rd open stream gets 503 until one closes.
 #[test]
-fn event_streams_are_at_most_32_and_head_gives_its_place_back() {
+fn event_streams_are_at_most_32_and_a_head_opens_none() {
     let server = Server::start(None);
     let port = server.port;
     for n in 0..40 {
@@ -1426,6 +1427,29 @@ fn event_streams_are_at_most_32_and_head_gives_its_place_back() {
         assert!(text.starts_with("HTTP/1.1 200 OK\r\n"), "HEAD {n}: {text}");
         assert!(text.ends_with("\r\n\r\n"), "HEAD {n}: a body: {text:?}");
     }
+    let mut kept = TcpStream::connect(("127.0.0.1", port)).unwrap();
+    kept.set_read_timeout(Some(Duration::from_millis(200)))
+        .unwrap();
+    let host = format!("Host: 127.0.0.1:{port}");
+    write!(kept, "HEAD /api/events HTTP/1.1\r\n{host}\r\n\r\n").unwrap();
+    let mut seen = Vec::new();
+    read_until(&mut kept, &mut seen, 0, "\r\n\r\n", Duration::from_secs(10));
+    let head = String::from_utf8_lossy(&seen).to_lowercase();
+    assert!(head.starts_with("http/1.1 200 ok\r\n"), "{head}");
+    assert!(!head.contains("connection: close"), "{head}");
+    let mark = seen.len();
+    write!(
+        kept,
+        "GET /api/scene HTTP/1.1\r\n{host}\r\nConnection: close\r\n\r\n"
+    )
+    .unwrap();
+    read_until(
+        &mut kept,
+        &mut seen,
+        mark,
+        "HTTP/1.1 200 OK\r\n",
+        Duration::from_secs(10),
+    );
     let open: Vec<_> = (0..32)
         .map(|_| open_events(port, "GET", ": connected at version 1\n\n"))
         .collect();

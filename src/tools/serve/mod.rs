@@ -670,12 +670,18 @@ fn render(shared: &Shared, request: Request, query: &str) {
 /// events back, so this answer is written straight to the connection: a
 /// status line and headers, then each event, flushed as it happens.
 fn events(shared: &Shared, request: Request) {
+    // HEAD asks for the head alone: it is answered as any other request, so the
+    // connection stays open or closes as the client asked, and opens no stream.
+    // (Written by hand, as a stream's head is, it left the socket open under a
+    // head saying `Connection: close`.)
+    if *request.method() == Method::Head {
+        return send(request, 200, "text/event-stream", Vec::new(), &[]);
+    }
     let streams = Arc::clone(&shared.streams);
     if streams.fetch_add(1, Ordering::SeqCst) >= MAX_STREAMS {
         streams.fetch_sub(1, Ordering::SeqCst);
         return error(request, 503, "too many event streams are open");
     }
-    let head_only = *request.method() == Method::Head;
     let studio = Arc::clone(&shared.studio);
     let mut writer = request.into_writer();
     std::thread::spawn(move || {
@@ -685,12 +691,9 @@ fn events(shared: &Shared, request: Request) {
                     Connection: close\r\n\r\n";
         let opened = writer
             .write_all(head.as_bytes())
-            .and_then(|()| match head_only {
-                true => Ok(()),
-                false => write!(writer, "retry: 1000\n: connected at version {version}\n\n"),
-            })
+            .and_then(|()| write!(writer, "retry: 1000\n: connected at version {version}\n\n"))
             .and_then(|()| writer.flush());
-        if opened.is_ok() && !head_only {
+        if opened.is_ok() {
             stream_events(&studio, writer, version);
         }
         streams.fetch_sub(1, Ordering::SeqCst);
