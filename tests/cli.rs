@@ -32,6 +32,18 @@ fn png_file(path: &Path) -> Vec<u8> {
     bytes
 }
 
+/// Write a `width` × `height` RGB EXR, `dir/name`, each pixel's colour given by
+/// its (row, column).
+fn write_exr(
+    dir: &Path,
+    name: &str,
+    (width, height): (usize, usize),
+    colour: impl Fn(usize, usize) -> (f32, f32, f32) + Sync,
+) {
+    exr::prelude::write_rgb_file(dir.join(name), width, height, |col, row| colour(row, col))
+        .unwrap();
+}
+
 fn png_size(path: &Path) -> (u32, u32) {
     let bytes = png_file(path);
     let be = |i: usize| u32::from_be_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
@@ -242,9 +254,7 @@ fn check_counts_the_spheres_past_the_first_twenty() {
 fn check_json_states_the_seed_scenes_numbers() {
     use serde_json::json;
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = raystep(root, &["check", "scenes/seed.toml", "--json"]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = json_of(root, &["check", "scenes/seed.toml", "--json"]);
     assert_eq!(v["scene"], "scenes/seed.toml", "the path as given");
     for (key, expected) in [
         ("width", json!(300)),
@@ -465,14 +475,12 @@ fn size_flags_override_a_size_the_file_gets_wrong() {
 #[test]
 fn bench_prints_one_json_object_with_the_promised_keys() {
     let dir = tempfile::tempdir().unwrap();
-    let out = raystep(
+    let json = json_of(
         dir.path(),
         &[
             "bench", "--width", "64", "--height", "36", "--runs", "1", "--json",
         ],
     );
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     for key in [
         "median_s",
         "rays",
@@ -763,15 +771,14 @@ fn diff_places_the_largest_difference_at_its_row_and_column() {
     let dir = tempfile::tempdir().unwrap();
     let (width, height) = (30, 20);
     let write = |name: &str, changed: bool| {
-        exr::prelude::write_rgb_file(dir.path().join(name), width, height, |col, row| {
+        write_exr(dir.path(), name, (width, height), |row, col| {
             let green = match (changed, row, col) {
                 (true, 5, 17) => 0.75,
                 (true, 12, 3) => 0.35,
-                _ => 0.25f32,
+                _ => 0.25,
             };
-            (0.5f32, green, 0.125f32)
-        })
-        .unwrap();
+            (0.5, green, 0.125)
+        });
     };
     write("a.exr", false);
     write("b.exr", true);
@@ -806,11 +813,10 @@ fn diff_places_the_largest_difference_at_its_row_and_column() {
 fn diff_gives_the_share_of_differing_pixels_in_percent_and_fails_above_fail_percent() {
     let dir = tempfile::tempdir().unwrap();
     for (name, changed) in [("a.exr", false), ("b.exr", true)] {
-        exr::prelude::write_rgb_file(dir.path().join(name), 30, 20, |col, row| {
+        write_exr(dir.path(), name, (30, 20), |row, col| {
             let differs = changed && [(0, 0), (7, 11), (19, 29)].contains(&(row, col));
-            (if differs { 0.75 } else { 0.25f32 }, 0.25f32, 0.25f32)
-        })
-        .unwrap();
+            (if differs { 0.75 } else { 0.25 }, 0.25, 0.25)
+        });
     }
     let json = raystep(dir.path(), &["diff", "a.exr", "b.exr", "--json"]);
     let report: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
@@ -839,14 +845,13 @@ fn diff_gives_the_share_of_differing_pixels_in_percent_and_fails_above_fail_perc
 fn diff_counts_the_pixels_not_finite_in_a_then_in_b() {
     let dir = tempfile::tempdir().unwrap();
     let write = |name: &str, odd: &[((usize, usize), f32)]| {
-        exr::prelude::write_rgb_file(dir.path().join(name), 4, 3, |col, row| {
+        write_exr(dir.path(), name, (4, 3), |row, col| {
             let red = odd
                 .iter()
                 .find(|(at, _)| *at == (row, col))
                 .map_or(0.5, |&(_, v)| v);
-            (red, 0.5f32, 0.5f32)
-        })
-        .unwrap();
+            (red, 0.5, 0.5)
+        });
     };
     write("a.exr", &[((0, 1), f32::NAN), ((2, 3), f32::INFINITY)]);
     write("b.exr", &[((1, 0), f32::INFINITY)]);
@@ -915,14 +920,12 @@ fn a_1080p_render_with_every_buffer_peaks_at_or_under_150_mb() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let out = raystep(
+    let report = json_of(
         dir.path(),
         &[
             "render", "--width", "1920", "--height", "1080", "-o", "o", "--json", "-q",
         ],
     );
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["files"].as_array().unwrap().len(), 13, "{report}");
     let peak = report["peak_memory_bytes"]
         .as_u64()
@@ -1441,8 +1444,7 @@ fn each_exr_compression_writes_the_scheme_openexr_names() {
         let out = raystep(dir.path(), &args);
         assert!(out.status.success(), "{name}: {}", text(&out.stderr));
         let path = dir.path().join(name).join("buffers.exr");
-        let meta = exr::meta::MetaData::read_from_file(&path, false).unwrap();
-        let header = &meta.headers[0];
+        let header = exr_header(&path);
         assert_eq!(header.compression, scheme, "--exr-compression {name}");
         assert_eq!(header.compression.scan_lines_per_block(), lines);
         assert_eq!(header.chunk_count, 40usize.div_ceil(lines), "{name}");
@@ -1452,22 +1454,14 @@ fn each_exr_compression_writes_the_scheme_openexr_names() {
 /// The chunk types of a PNG file, in order (README: `--png srgb` writes an
 /// `sRGB` chunk, `linear` none).
 fn png_chunks(path: &Path) -> Vec<String> {
-    let bytes = png_file(path);
-    let mut chunks = Vec::new();
-    let mut at = 8;
-    while at + 8 <= bytes.len() {
-        let length = u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
-        chunks.push(String::from_utf8_lossy(&bytes[at + 4..at + 8]).into_owned());
-        at += 12 + length; // length, type, data, CRC
-    }
-    chunks
+    common::png_chunks(&png_file(path))
 }
 
-/// The compression a `buffers.exr` file's header names.
-fn exr_compression(path: &Path) -> exr::compression::Compression {
+/// The header of the EXR file at `path` (its one part).
+fn exr_header(path: &Path) -> exr::meta::header::Header {
     let meta = exr::meta::MetaData::read_from_file(path, false)
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    meta.headers[0].compression
+    meta.headers.into_iter().next().unwrap()
 }
 
 /// README: without `--out`, `render` and `stages` write into `out/`; `--output
@@ -1503,9 +1497,7 @@ fn tutorial_sets_all_five_rules_and_flags_beside_it_still_apply() {
     let dir = tempfile::tempdir().unwrap();
     let rules = |flags: &[&str]| -> String {
         let args = [&["explain", "--pixel", "150,100", "--json"][..], flags].concat();
-        let out = raystep(dir.path(), &args);
-        assert!(out.status.success(), "{flags:?}: {}", text(&out.stderr));
-        let story: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let story = json_of(dir.path(), &args);
         story["rules"].as_str().unwrap().to_string()
     };
     assert_eq!(
@@ -1589,7 +1581,7 @@ fn png_and_exr_defaults_and_their_flags_on_render_and_stages() {
     let plain = dir.path().join("plain");
     assert!(!png_chunks(&plain.join("beauty.png")).contains(&"sRGB".to_string()));
     assert_eq!(
-        exr_compression(&plain.join("buffers.exr")),
+        exr_header(&plain.join("buffers.exr")).compression,
         Compression::Uncompressed
     );
     let out = raystep(
@@ -1611,7 +1603,7 @@ fn png_and_exr_defaults_and_their_flags_on_render_and_stages() {
         let chunks = png_chunks(&folder.join("beauty.png"));
         assert!(chunks.contains(&"sRGB".to_string()), "{stage}: {chunks:?}");
         assert_eq!(
-            exr_compression(&folder.join("buffers.exr")),
+            exr_header(&folder.join("buffers.exr")).compression,
             Compression::ZIP16,
             "{stage}"
         );

@@ -45,17 +45,7 @@ fn the_srgb_transfer_function_gives_the_known_answers() {
     }
 }
 
-/// The chunk types of a PNG file, in order.
-fn chunks(bytes: &[u8]) -> Vec<String> {
-    let mut found = Vec::new();
-    let mut at = 8;
-    while at + 8 <= bytes.len() {
-        let length = u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
-        found.push(String::from_utf8_lossy(&bytes[at + 4..at + 8]).into_owned());
-        at += 12 + length;
-    }
-    found
-}
+use common::png_chunks as chunks;
 
 fn rgb(path: &Path) -> Vec<u8> {
     image::open(path).unwrap().to_rgb8().into_raw()

@@ -124,9 +124,17 @@ impl Reply {
 /// `GET target` from the server on `port`, with the right Host header (from
 /// any thread: the port is all it needs).
 fn get(port: u16, target: &str) -> Reply {
+    get_with(port, target, "")
+}
+
+/// `GET target` as [`get`] sends it, with `extra` header lines (each ending in
+/// `\r\n`).
+fn get_with(port: u16, target: &str, extra: &str) -> Reply {
     exchange(
         port,
-        &format!("GET {target} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n"),
+        &format!(
+            "GET {target} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n{extra}Connection: close\r\n\r\n"
+        ),
     )
 }
 
@@ -930,9 +938,11 @@ fn a_request_for_another_host_is_421() {
         "GET /api/scene HTTP/1.1\r\nHost: LocalHost:{port}\r\nConnection: close\r\n\r\n"
     ));
     assert_eq!(local.status, 200);
-    let cross = server.raw(&format!(
-        "GET /api/render?width=8&height=8 HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nSec-Fetch-Site: cross-site\r\nConnection: close\r\n\r\n"
-    ));
+    let cross = get_with(
+        port,
+        "/api/render?width=8&height=8",
+        "Sec-Fetch-Site: cross-site\r\n",
+    );
     assert_eq!(cross.status, 403);
 }
 
@@ -1243,14 +1253,6 @@ fn the_host_header_is_checked_exactly() {
     }
 }
 
-/// `GET target` with `extra` header lines (each ending in `\r\n`).
-fn get_with(server: &Server, target: &str, extra: &str) -> Reply {
-    let port = server.port;
-    server.raw(&format!(
-        "GET {target} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n{extra}Connection: close\r\n\r\n"
-    ))
-}
-
 /// The API's answers are JSON, refusals too, and say so; nothing it answers is
 /// kept by a cache (a scene file changes under the same URL), nor sniffed as
 /// another type.
@@ -1334,7 +1336,7 @@ fn only_the_page_itself_or_a_typed_address_passes_sec_fetch_site() {
         ("cross-site", 403),
     ] {
         let reply = get_with(
-            &server,
+            server.port,
             "/api/scene",
             &format!("Sec-Fetch-Site: {site}\r\n"),
         );

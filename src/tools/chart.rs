@@ -860,12 +860,13 @@ mod tests {
 
     #[test]
     fn charts_draw_to_svg_and_png_without_system_fonts() {
-        let dir = tempfile_dir();
+        let folder = tempfile::tempdir().unwrap();
+        let dir = folder.path();
         let mut points = vec![point("a", 1.0, 2.0), point("b", 2.0, 1.0)];
         points[0].default = true;
         mark_frontier(&mut points);
         let mut pending = Pending::new();
-        let files = write_sweep(&mut pending, &dir, "t", &points, "test").unwrap();
+        let files = write_sweep(&mut pending, dir, "t", &points, "test").unwrap();
         pending.commit().unwrap();
         let svg = std::fs::read_to_string(&files[0]).unwrap();
         assert!(svg.contains("Pareto frontier") && svg.contains("milliseconds per frame"));
@@ -874,7 +875,6 @@ mod tests {
         let png = image::open(&files[1]).unwrap().to_rgb8();
         // Some pixels are not white: the axes, the points, the text.
         assert!(png.pixels().filter(|p| p.0 != [255, 255, 255]).count() > 1000);
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     /// Ties decide the frontier too: a point as accurate as another but slower, or
@@ -1053,9 +1053,9 @@ mod tests {
     /// row is read by the names of its columns, milliseconds made seconds.
     #[test]
     fn scale_reads_the_embree_programs_row_by_its_column_names() {
-        let dir = std::env::temp_dir().join(format!("raystep-embree-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let program = fake_embree(&dir, 0);
+        let folder = tempfile::tempdir().unwrap();
+        let dir = folder.path();
+        let program = fake_embree(dir, 0);
         let points = scale(&[4], 0, (8, 6), 1, Some(&program), &|_| {}).unwrap();
         let embree: Vec<&ScalePoint> = points
             .iter()
@@ -1076,13 +1076,12 @@ mod tests {
         assert_eq!(stdin, crate::tools::generate::spheres_toml(4, 1));
         assert!(scale_csv(&points).contains("\n4,embree,40.000,2.500,0,40.000\n"));
         // A program that fails is an error, whatever it printed.
-        let failing = fake_embree(&dir, 1);
+        let failing = fake_embree(dir, 1);
         let err = scale(&[4], 0, (8, 6), 1, Some(&failing), &|_| {}).unwrap_err();
         assert!(
             err.to_string().contains("the Embree program failed"),
             "{err}"
         );
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     /// The blue line joins the frontier's points alone, left to right: of four
@@ -1090,8 +1089,7 @@ mod tests {
     /// of three vertices and the legend's sample of two.
     #[test]
     fn the_frontier_line_joins_only_the_frontier_points_in_order_of_time() {
-        let dir = std::env::temp_dir().join(format!("raystep-frontier-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = tempfile::tempdir().unwrap();
         let mut points = vec![
             point("c", 3.0, 1.0),
             point("a", 1.0, 3.0),
@@ -1100,7 +1098,7 @@ mod tests {
         ];
         mark_frontier(&mut points);
         let mut pending = Pending::new();
-        let files = write_sweep(&mut pending, &dir, "f", &points, "test").unwrap();
+        let files = write_sweep(&mut pending, dir.path(), "f", &points, "test").unwrap();
         pending.commit().unwrap();
         let svg = std::fs::read_to_string(&files[0]).unwrap();
         let mut lines: Vec<Vec<i64>> = svg
@@ -1123,12 +1121,5 @@ mod tests {
             "{lines:?}"
         );
         assert!(lines[1].windows(2).all(|w| w[0] < w[1]), "{lines:?}");
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    fn tempfile_dir() -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("raystep-chart-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
     }
 }

@@ -354,3 +354,15 @@ pub fn record_bits(p: &PixelRecord) -> [u32; 13] {
         p.rays,
     ]
 }
+
+/// The chunk types of a PNG file's bytes, in order.
+pub fn png_chunks(bytes: &[u8]) -> Vec<String> {
+    let mut found = Vec::new();
+    let mut at = 8;
+    while at + 8 <= bytes.len() {
+        let length = u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        found.push(String::from_utf8_lossy(&bytes[at + 4..at + 8]).into_owned());
+        at += 12 + length; // length, type, data, CRC
+    }
+    found
+}
