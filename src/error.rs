@@ -2,6 +2,7 @@
 //! be valid. The command line prints them and exits with [`USER_ERROR`] (130 after
 //! an interrupt).
 
+use std::borrow::Cow;
 use std::fmt;
 use std::path::PathBuf;
 
@@ -70,5 +71,48 @@ pub fn check_interrupt() -> Result<(), Error> {
         Err(Error::Interrupted)
     } else {
         Ok(())
+    }
+}
+
+/// `text` safe to print on a terminal: every control character but newline and
+/// tab shown as its Unicode control picture (`ESC` as `␛`, `DEL` as `␡`) and the
+/// C1 controls (U+0080–U+009F) as `�`. A scene file or a file name quoted in a
+/// message then cannot clear the screen, set the window's title or move the
+/// cursor, and each character still takes one column, so the `^` under a quoted
+/// line stays under its place.
+pub fn for_terminal(text: &str) -> Cow<'_, str> {
+    let unsafe_char = |c: char| c.is_control() && c != '\n' && c != '\t';
+    if !text.contains(unsafe_char) {
+        return Cow::Borrowed(text);
+    }
+    text.chars()
+        .map(|c| match c {
+            '\u{7f}' => '\u{2421}',
+            c if unsafe_char(c) && u32::from(c) < 0x20 => {
+                char::from_u32(0x2400 + u32::from(c)).unwrap_or('\u{fffd}')
+            }
+            c if unsafe_char(c) => '\u{fffd}',
+            c => c,
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// ESC, BEL, CR, NUL, DEL and CSI (U+009B) never reach the terminal; newline,
+    /// tab and every printable character (accents, `…`, `^`) do, unchanged.
+    #[test]
+    fn control_characters_are_shown_not_obeyed() {
+        assert_eq!(
+            for_terminal("a # \u{1b}[2J\u{1b}]0;pwned\u{7}\r\0\u{7f}\u{9b}"),
+            "a # \u{241b}[2J\u{241b}]0;pwned\u{2407}\u{240d}\u{2400}\u{2421}\u{fffd}"
+        );
+        let plain = "line 2, column 9: é … ^\n\t2 | x";
+        assert!(matches!(for_terminal(plain), Cow::Borrowed(p) if p == plain));
+        // One character each: a caret under the line stays under its place.
+        let line = "x = 1 # \u{1b}\u{1b} y";
+        assert_eq!(for_terminal(line).chars().count(), line.chars().count());
     }
 }

@@ -23,7 +23,10 @@ fn main() -> ExitCode {
                         path: "standard output".into(),
                         message: io.to_string(),
                     };
-                    eprintln!("error: {error}");
+                    eprintln!(
+                        "error: {}",
+                        raystep::error::for_terminal(&error.to_string())
+                    );
                     ExitCode::from(error.exit_code())
                 }
                 _ => ExitCode::from(e.exit_code() as u8),
@@ -34,7 +37,10 @@ fn main() -> ExitCode {
     match execute(cli) {
         Ok(code) => ExitCode::from(code),
         Err(error) => {
-            eprintln!("error: {error}");
+            eprintln!(
+                "error: {}",
+                raystep::error::for_terminal(&error.to_string())
+            );
             ExitCode::from(error.exit_code())
         }
     }

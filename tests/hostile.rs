@@ -65,6 +65,12 @@ fn check_output(what: &str, out: &Output, expected: &Expected) {
         !said.contains("panicked") && !said.contains("RUST_BACKTRACE"),
         "{what}: a panic:\n{said}"
     );
+    // Nothing a terminal would obey: a scene's control characters are quoted as
+    // their pictures (␛ for ESC).
+    assert!(
+        !said.contains(|c: char| c.is_control() && c != '\n' && c != '\t'),
+        "{what}: a control character reaches the terminal:\n{said:?}"
+    );
     for words in &expected.expect {
         assert!(
             said.contains(words.as_str()),
@@ -399,6 +405,22 @@ fn raystep_writes_only_the_names_it_owns() {
             || (name.matches('/').count() == 0 && name.starts_with("0"));
         assert!(known, "raystep wrote {name}");
         assert!(!file.ends_with(".tmp"), "a temporary file was left: {name}");
+    }
+}
+
+/// A file name is quoted as a scene's text is: a name holding ESC (which a
+/// terminal would take for the start of a command) is shown with ␛.
+#[test]
+fn a_file_name_with_control_characters_is_shown_not_obeyed() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = "\u{1b}[31mred\u{7}.toml";
+    std::fs::write(dir.path().join(name), "[camera]\nposition = [0, 0, 1]\n").unwrap();
+    for args in [&["check", name][..], &["render", name, "--out", "out"]] {
+        let out = raystep(dir.path(), args);
+        let said = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{said}");
+        assert!(said.contains("\u{241b}[31mred\u{2407}.toml"), "{said:?}");
+        assert!(!said.contains(['\u{1b}', '\u{7}']), "{said:?}");
     }
 }
 

@@ -500,7 +500,8 @@ impl RuleArgs {
         let warnings = crate::io::scene_file::check_precision(scene, precision)
             .map_err(|e| Error::Usage(format!("{name}: --precision {precision}: {e}")))?;
         for warning in warnings {
-            eprintln!("warning: {name}: --precision {precision}: {warning}");
+            let said = format!("warning: {name}: --precision {precision}: {warning}");
+            eprintln!("{}", crate::error::for_terminal(&said));
         }
         Ok(Settings {
             stages,
@@ -560,10 +561,11 @@ pub fn load_scene(args: &SceneArgs) -> Result<(Scene, String), Error> {
 /// A scene without objects is valid, but almost surely not what was meant.
 pub fn warn_if_empty(scene: &Scene, name: &str) {
     if scene.objects.is_empty() {
-        eprintln!(
+        let said = format!(
             "warning: {name}: the scene has no [[sphere]] and no [[plane]], so every ray \
              misses and the image is black"
         );
+        eprintln!("{}", crate::error::for_terminal(&said));
     }
 }
 

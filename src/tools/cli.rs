@@ -49,7 +49,12 @@ fn quiet() -> bool {
 fn status_line(text: std::fmt::Arguments) {
     use std::io::Write;
     if !quiet() {
-        let _ = writeln!(std::io::stderr().lock(), "{text}");
+        let text = text.to_string();
+        let _ = writeln!(
+            std::io::stderr().lock(),
+            "{}",
+            crate::error::for_terminal(&text)
+        );
     }
 }
 

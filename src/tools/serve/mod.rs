@@ -94,7 +94,7 @@ pub fn run(args: &ServeArgs, quiet: bool) -> Result<(), Error> {
     if !quiet {
         eprintln!(
             "serving {} on {url} (127.0.0.1 only); Ctrl-C to stop",
-            studio.name()
+            crate::error::for_terminal(studio.name())
         );
     }
     if args.open {
