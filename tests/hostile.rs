@@ -368,6 +368,10 @@ fn raystep_writes_only_the_names_it_owns() {
         ("beauty.png.bak", "an old copy"),
         (".beauty.png.tmp", "another program's temporary"),
         ("01-rays/my-sketch.svg", "<svg/>"),
+        // At the names of buffers a rays-only render does not write, in folders
+        // that never held raystep's buffers.exr: the user's, not stale buffers.
+        ("depth.png", "my own depth"),
+        ("01-rays/normal.png", "my own normals"),
     ];
     std::fs::create_dir(out.join("01-rays")).unwrap();
     for (name, text) in mine {
@@ -406,6 +410,45 @@ fn raystep_writes_only_the_names_it_owns() {
         assert!(known, "raystep wrote {name}");
         assert!(!file.ends_with(".tmp"), "a temporary file was left: {name}");
     }
+}
+
+/// A buffer's PNG is stale, and removed by a render that does not write it, only
+/// when the earlier render's `buffers.exr` in that folder lists the buffer's
+/// channels: with that file gone, or not an EXR, `depth.png` is left alone.
+#[test]
+fn only_the_buffers_the_earlier_exr_lists_are_removed_as_stale() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |args: &[&str]| {
+        let mut all = vec!["render", "--width", "20", "--height", "10"];
+        all.extend_from_slice(args);
+        let out = raystep(dir.path(), &all);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let out = dir.path().join("out");
+    run(&[]);
+    let depth = std::fs::read(out.join("depth.png")).unwrap();
+    for not_raysteps in [None, Some("not an EXR")] {
+        match not_raysteps {
+            None => std::fs::remove_file(out.join("buffers.exr")).unwrap(),
+            Some(text) => std::fs::write(out.join("buffers.exr"), text).unwrap(),
+        }
+        run(&["--stage", "rays"]);
+        assert_eq!(std::fs::read(out.join("depth.png")).unwrap(), depth);
+        // The rays-only render's own EXR lists no depth: still left alone.
+        run(&["--stage", "rays"]);
+        assert_eq!(std::fs::read(out.join("depth.png")).unwrap(), depth);
+    }
+    // After a render of every buffer, its EXR lists them: a rays-only render
+    // removes every PNG it does not write.
+    run(&[]);
+    run(&["--stage", "rays"]);
+    let mut left: Vec<String> = names(&out);
+    left.sort();
+    assert_eq!(left, ["beauty.png", "buffers.exr", "direction.png"]);
 }
 
 /// A file name is quoted as a scene's text is: a name holding ESC (which a
@@ -1004,9 +1047,18 @@ fn symbolic_links_are_never_written_or_deleted_through() {
     assert!(said.contains("03-shadow: it is a symbolic link"), "{said}");
     assert_eq!(snapshot(root), before, "a refused run changed something");
     // Links at raystep's own file names: the link itself is replaced (a written
-    // buffer) or removed (a stale one), never the file it points to.
+    // buffer) or removed (a stale one: a buffer the earlier render's buffers.exr
+    // lists), never the file it points to.
     let render = root.join("render");
-    std::fs::create_dir(&render).unwrap();
+    let earlier = raystep(
+        root,
+        &[
+            "render", "ok.toml", "--width", "20", "--height", "10", "--out", "render",
+        ],
+    );
+    assert!(earlier.status.success());
+    std::fs::remove_file(render.join("beauty.png")).unwrap();
+    std::fs::remove_file(render.join("depth.png")).unwrap();
     symlink("../victim.txt", render.join("beauty.png")).unwrap();
     symlink("../elsewhere/depth.png", render.join("depth.png")).unwrap();
     let run = raystep(

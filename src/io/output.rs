@@ -206,7 +206,10 @@ impl Pending {
     /// Write the files of `frame` into `dir` (a [`Pending::folder`]): one PNG per
     /// buffer and [`EXR_FILE`], encoded in parallel. Buffer files of an earlier
     /// render that this frame does not have (say `depth.png` after a `rays`-only
-    /// render) will be removed by the commit. Returns the files' final paths.
+    /// render) will be removed by the commit: those whose channels the earlier
+    /// render's [`EXR_FILE`] in `dir` lists ([`earlier_buffers`]), so a file of the
+    /// same name that raystep did not write is left alone. Returns the files'
+    /// final paths.
     ///
     /// Every file is streamed from the frame in one pass over its records (see
     /// `write_files`), so no copy of the buffers is made: at 1920 × 1080 the
@@ -218,10 +221,11 @@ impl Pending {
             .map(|b| dir.join(format!("{}.png", b.name())))
             .collect();
         paths.push(dir.join(EXR_FILE));
+        let earlier = earlier_buffers(&dir.join(EXR_FILE));
         let temporaries: Vec<PathBuf> = paths.iter().map(|p| self.register(p)).collect();
         write_files(frame, &buffers, self.png, self.exr, &temporaries, &paths)?;
         self.stale.extend(
-            Buffer::ALL
+            earlier
                 .into_iter()
                 .filter(|&b| !frame.has(b))
                 .map(|b| dir.join(format!("{}.png", b.name()))),
@@ -993,6 +997,33 @@ pub const EXR_CHANNELS: [(&str, Buffer); 26] = [
     ("bounces.X", Buffer::Bounces),
     ("rays.X", Buffer::Rays),
 ];
+
+/// The buffers an earlier render wrote beside the EXR file at `path`: those whose
+/// channels ([`EXR_CHANNELS`]) its header lists. None when there is no regular
+/// file there (a link, a folder or a FIFO is not read) or it is not an EXR file
+/// that can be read: a `depth.png` in a folder that never held raystep's
+/// `buffers.exr` is the user's own.
+pub fn earlier_buffers(path: &Path) -> Vec<Buffer> {
+    if !fs::symlink_metadata(path).is_ok_and(|m| m.is_file()) {
+        return Vec::new();
+    }
+    let Ok(meta) = exr::meta::MetaData::read_from_file(path, false) else {
+        return Vec::new();
+    };
+    let names: Vec<String> = meta
+        .headers
+        .iter()
+        .flat_map(|h| h.channels.list.iter().map(|c| c.name.to_string()))
+        .collect();
+    Buffer::ALL
+        .into_iter()
+        .filter(|b| {
+            EXR_CHANNELS
+                .iter()
+                .any(|(name, of)| of == b && names.iter().any(|n| n == name))
+        })
+        .collect()
+}
 
 /// Every sample of pixel (`row`, `col`), in the order of [`EXR_CHANNELS`]:
 /// beauty, direction, depth (+∞ on a miss), normal, position (`(0, 0, 0)` on a
