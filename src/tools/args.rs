@@ -132,7 +132,7 @@ pub struct ExplainArgs {
     #[allow(missing_docs)]
     pub frame: FrameArgs,
     /// The pixel: column and row from the top-left corner, e.g. 150,120.
-    #[arg(long, value_parser = parse_pixel)]
+    #[arg(long, value_parser = parse_pixel, allow_hyphen_values = true)]
     pub pixel: (u32, u32),
     /// Print one JSON object instead of the story in words (its depth is the
     /// first hit's distance, null on a miss).
@@ -156,14 +156,14 @@ pub struct ChartArgs {
     #[allow(missing_docs)]
     pub scene: SceneArgs,
     /// Timed runs of each setting, after one warm-up run.
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000), allow_negative_numbers = true)]
     pub runs: u32,
     /// Chart time against the number of spheres instead, on generated scenes at
     /// --width × --height (default 1920 × 1080).
     #[arg(long)]
     pub scale: bool,
     /// With --scale, the largest count (powers of ten and their triples up to it).
-    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..=10_000_000), requires = "scale")]
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..=10_000_000), requires = "scale", allow_negative_numbers = true)]
     pub max_count: u64,
     /// With --scale, also time the Embree program at PATH on each scene (built by
     /// benches/embree/run.sh build), drawn beside raystep's points.
@@ -190,11 +190,11 @@ pub enum Generated {
         /// How many spheres, 1 to 1,000,000. Up to 100,000 the scene file lists
         /// them (a file of 100,000 is 16.7 MB, near the 16 MiB a scene file may be);
         /// above, it holds their recipe, the scene file's generate section.
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000), allow_negative_numbers = true)]
         count: u32,
         /// The seed of the random numbers, 0 to 9223372036854775807 (TOML's largest
         /// integer): the same seed, the same scene.
-        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(0..=i64::MAX as u64))]
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(0..=i64::MAX as u64), allow_negative_numbers = true)]
         seed: u64,
         /// Write the recipe (the generate section: spheres = N, seed = S) at any
         /// count, not the list: a small file that loads in a fraction of the time.
@@ -210,10 +210,10 @@ pub struct BenchArgs {
     #[allow(missing_docs)]
     pub frame: FrameArgs,
     /// Threads to render with [default: one per core].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024), allow_negative_numbers = true)]
     pub threads: Option<u32>,
     /// Timed runs of each measurement, after one warm-up run.
-    #[arg(long, default_value_t = 7, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    #[arg(long, default_value_t = 7, value_parser = clap::value_parser!(u32).range(1..=1000), allow_negative_numbers = true)]
     pub runs: u32,
     /// Skip the yardstick (the tutorial's program ported plainly).
     #[arg(long)]
@@ -242,11 +242,11 @@ pub struct SceneArgs {
     pub scene: Option<PathBuf>,
     /// Image width in pixels (overrides the scene's [image] width; 1 to 16384, and
     /// at most 7680 × 4320 pixels in all: about 64 bytes of memory each).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<16384>)]
     pub width: Option<u32>,
     /// Image height in pixels (overrides the scene's [image] height; 1 to 16384, and
     /// at most 7680 × 4320 pixels in all).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<16384>)]
     pub height: Option<u32>,
 }
 
@@ -276,12 +276,12 @@ pub struct RuleArgs {
     #[arg(long, value_enum, default_value_t = Viewer::Camera)]
     pub viewer: Viewer,
     /// Most segments per pixel path (overrides the scene's render.max_depth; 1 to 64).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<64>)]
     pub max_depth: Option<u32>,
     /// Samples per pixel, a square number from 1 to 1024: stratified over an n × n
     /// grid, jittered the same way on every run [default: 1, the tutorial's one ray
     /// per pixel].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<1024>)]
     pub spp: Option<u32>,
     /// End a reflection path once what is left of it cannot move a channel by half
     /// an 8-bit step [default: on; off with --tutorial].
@@ -408,15 +408,25 @@ pub struct DiffArgs {
     /// The tolerance of one channel, as idiff's -fail: a pixel differs when some
     /// channel of its beauty (linear, 1 = white) differs by more than this. The
     /// default is one 8-bit step, 1/255.
-    #[arg(long, default_value_t = 1.0 / 255.0, value_parser = parse_threshold)]
+    #[arg(long, default_value_t = 1.0 / 255.0, value_parser = parse_threshold, allow_negative_numbers = true)]
     pub threshold: f32,
     /// The percentage of pixels that may differ before the images count as
     /// different, as idiff's -failpercent (0 to 100).
-    #[arg(long, default_value_t = 0.0, value_parser = parse_percent)]
+    #[arg(long, default_value_t = 0.0, value_parser = parse_percent, allow_negative_numbers = true)]
     pub fail_percent: f64,
     /// Print one JSON object instead of the report in words.
     #[arg(long)]
     pub json: bool,
+}
+
+/// A count given on the command line: any whole number a `u32` holds (whether it
+/// is in range, 1 to `MAX`, is checked with the scene, in the words of the
+/// scene's own checks); anything else, a negative number or a fraction, is told
+/// the range.
+fn whole<const MAX: u32>(text: &str) -> Result<u32, String> {
+    text.trim()
+        .parse::<u32>()
+        .map_err(|_| format!("expected a whole number from 1 to {MAX}"))
 }
 
 /// A channel tolerance: a finite number, 0 or more.
@@ -503,10 +513,19 @@ impl RuleArgs {
             let said = format!("warning: {name}: --precision {precision}: {warning}");
             eprintln!("{}", crate::error::for_terminal(&said));
         }
+        let method = self.intersect.unwrap_or(base.method);
+        if self.accel == Some(Accel::Bvh) && method == Method::Naive {
+            eprintln!(
+                "warning: --accel bvh: the textbook quadratic (--intersect naive{}) gets no \
+                 BVH, since its false hits far outside a sphere (chapter 9) would fall \
+                 outside the boxes; every object is tested, as with --accel off",
+                if self.tutorial { ", by --tutorial" } else { "" }
+            );
+        }
         Ok(Settings {
             stages,
             precision,
-            method: self.intersect.unwrap_or(base.method),
+            method,
             offset: self.offset.unwrap_or(base.offset),
             viewer: self.viewer,
             accel: self.accel.unwrap_or(base.accel),

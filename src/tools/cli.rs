@@ -790,6 +790,15 @@ fn accuracy(args: &AccuracyArgs) -> Result<(), Error> {
 
 fn figures(args: &FiguresArgs) -> Result<(), Error> {
     let root = Path::new(".");
+    // The figures' commands name the repository's scenes (scenes/seed.toml, ...).
+    if !root.join("scenes").is_dir() || !root.join("chapters").is_dir() {
+        return Err(Error::Usage(
+            "figures renders the book's pictures from the repository's scenes/ into its \
+             chapters/img/: run it in the root of a raystep checkout (no scenes/ and \
+             chapters/ here)"
+                .into(),
+        ));
+    }
     if args.check {
         let problems = crate::tools::figures::check_all(root, &args.out, &render_command)?;
         if problems.is_empty() {
