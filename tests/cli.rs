@@ -1329,7 +1329,8 @@ fn float32_messages_name_the_scene_and_the_object_as_explain_numbers_it() {
     assert_eq!(code, Some(2), "{said}");
     assert!(
         said.starts_with(&format!(
-            "error: {scene}: --precision f32: object 1, radius: 0.1 is smaller than 0.100001, "
+            "error: {scene}: --precision f32: object 1 ([[sphere]] number 2), radius: 0.1 is \
+             smaller than 0.100001, "
         )),
         "{said}"
     );
@@ -1337,7 +1338,8 @@ fn float32_messages_name_the_scene_and_the_object_as_explain_numbers_it() {
     assert_eq!(code, Some(0), "{said}");
     assert!(
         said.starts_with(&format!(
-            "warning: {scene}: --precision f32: object 1 (a sphere, center [0, 0, -3], \
+            "warning: {scene}: --precision f32: object 1 ([[sphere]] number 2, a sphere, \
+             center [0, 0, -3], \
              radius 1.000000001) is object 0 in float32"
         )),
         "{said}"

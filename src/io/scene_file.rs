@@ -1260,18 +1260,14 @@ pub fn check_precision(scene: &Scene, precision: Precision) -> Result<Vec<String
         // Written out only in a message, as the loader does (100,000 spheres
         // would otherwise make as many strings).
         // Under the number explain, the studio and the `object` buffer give it.
-        let at = Lazy(|| format!("object {i} ({})", describe(object)));
+        // And under its entry in the file, as the loader's messages name it.
+        let entry = Lazy(|| format!("object {i} ({})", entry_of(scene, i)));
+        let at = Lazy(|| format!("object {i} ({}, {})", entry_of(scene, i), describe(object)));
         match &object.shape {
             Shape::Sphere(s) => {
                 // `placed` gives the centre and radius itself where it needs them.
-                placed(
-                    s,
-                    &Lazy(|| format!("object {i}")),
-                    scene.camera,
-                    light,
-                    MIN_RADIUS_RATIO,
-                )
-                .map_err(|e| format!("{e}{to_f64}"))?;
+                placed(s, &entry, scene.camera, light, MIN_RADIUS_RATIO)
+                    .map_err(|e| format!("{e}{to_f64}"))?;
                 // At the sphere's point farthest from the origin, where the step
                 // is longest.
                 let far = s.center + s.center.normalize_or(Vec3::X) * s.radius;
@@ -1352,6 +1348,22 @@ impl Told {
 
 /// float32's unit roundoff.
 const F32_U: f64 = f32::EPSILON as f64 / 2.0;
+
+/// Object `i` of `scene` as the file holds it, as the loader's messages name it:
+/// "`[[sphere]] number 2`" (counted from 1 among the entries of its table, where
+/// the object's index counts from 0 over every object, spheres first).
+fn entry_of(scene: &Scene, i: usize) -> String {
+    let role = scene.objects[i].role;
+    let n = scene.objects[..=i]
+        .iter()
+        .filter(|o| o.role == role)
+        .count();
+    let table = match role {
+        Role::Sphere => "sphere",
+        Role::Floor => "plane",
+    };
+    format!("[[{table}]] number {n}")
+}
 
 /// An object as messages name it.
 fn describe(object: &Object) -> String {
@@ -1616,7 +1628,7 @@ mod tests {
             "{warnings:#?}"
         );
         assert!(
-            warnings[0].starts_with("object 0 (a sphere"),
+            warnings[0].starts_with("object 0 ([[sphere]] number 1, a sphere"),
             "{}",
             warnings[0]
         );
@@ -1914,6 +1926,27 @@ mod tests {
         assert_eq!(unknown_key_hint("posit", light), None);
     }
 
+    /// Messages name an object by its index, counted from 0 over every object,
+    /// spheres first (as `explain` and the `object` buffer do), and by its entry in
+    /// the file, counted from 1 in its own table (as the loader's messages do): the
+    /// seed scene's floor is object 3, `[[plane]] number 1`.
+    #[test]
+    fn an_object_is_named_by_its_entry_in_the_file() {
+        let scene = whole(SEED_TOML).unwrap();
+        let entries: Vec<String> = (0..scene.objects.len())
+            .map(|i| entry_of(&scene, i))
+            .collect();
+        assert_eq!(
+            entries,
+            [
+                "[[sphere]] number 1",
+                "[[sphere]] number 2",
+                "[[sphere]] number 3",
+                "[[plane]] number 1"
+            ]
+        );
+    }
+
     #[test]
     fn a_quoted_token_is_cut_from_61_characters_on() {
         let sixty = format!("unknown field `{}`", "k".repeat(60));
@@ -1941,7 +1974,8 @@ mod tests {
         assert_eq!(warnings.len(), 1, "{warnings:#?}");
         assert!(
             warnings[0].starts_with(
-                "object 0 (a sphere, center [0, 0, -10], radius 0.01): its centre is 1.0e3 \
+                "object 0 ([[sphere]] number 1, a sphere, center [0, 0, -10], radius 0.01): \
+                 its centre is 1.0e3 \
                  radii from the origin"
             ) && warnings[0].contains("|L·N| = 0.02)"),
             "{}",
