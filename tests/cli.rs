@@ -513,6 +513,37 @@ fn bench_prints_one_json_object_with_the_promised_keys() {
     );
 }
 
+/// `bench --json`'s `bvh_nodes` is `null` when the render uses no BVH: with
+/// `--accel auto`, below 24 spheres (README.md: "a BVH from 24 spheres on").
+#[test]
+fn bench_reports_a_bvh_from_24_spheres_on() {
+    let dir = tempfile::tempdir().unwrap();
+    for (count, tree) in [("23", false), ("24", true)] {
+        let out = raystep(dir.path(), &["generate", "spheres", "--count", count]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let file = format!("{count}.toml");
+        std::fs::write(dir.path().join(&file), &out.stdout).unwrap();
+        let json = json_of(
+            dir.path(),
+            &[
+                "bench",
+                &file,
+                "--width",
+                "16",
+                "--height",
+                "9",
+                "--runs",
+                "1",
+                "--no-yardstick",
+                "--accel",
+                "auto",
+                "--json",
+            ],
+        );
+        assert_eq!(!json["bvh_nodes"].is_null(), tree, "{count}: {json}");
+    }
+}
+
 /// `bench --json`'s derived figures are the quotients README.md defines them by,
 /// each of the very times it names (a ratio inverted, or taken against another
 /// run's time, breaks one), `runs` is the count asked for, and the yardstick's rays

@@ -703,3 +703,29 @@ fn the_pixel_loop_allocates_nothing() {
         );
     }
 }
+
+/// README.md and `--accel`'s help: `--accel auto` builds a BVH "from 24 spheres
+/// on": a scene of 24 spheres (and its floor) gets one, a scene of 23 none.
+#[test]
+fn accel_auto_builds_the_bvh_from_24_spheres_on() {
+    use raystep::render::Tracer;
+    let settings = Settings::from(Stages::ALL);
+    assert_eq!(settings.accel, Accel::Auto);
+    for (count, tree) in [(23, false), (24, true)] {
+        let scene = raystep::io::scene_file::parse(
+            &raystep::tools::generate::spheres_toml(count, 1),
+            "generated.toml",
+        )
+        .unwrap();
+        assert_eq!(
+            Tracer::<f64>::new(&scene, &settings).bvh.is_some(),
+            tree,
+            "{count}"
+        );
+        assert_eq!(
+            Tracer::<f32>::new(&scene, &settings).bvh.is_some(),
+            tree,
+            "{count}"
+        );
+    }
+}

@@ -122,3 +122,77 @@ impl TileMasks {
         self.masks[((row / TILE.1) * self.columns + col / TILE.0) as usize]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::test_ball as ball;
+    use crate::camera::Screen;
+
+    /// A 32 × 16 image (2 × 2 tiles) whose pixel (row, col) looks at the screen
+    /// point (col, 15 − row, 0), seen from (15.5, 7.5, 10): above the corner the
+    /// four tiles share, so the planes between tiles are x = 15.5 (half a pixel
+    /// right of column 15) and y = 7.5 (half a pixel below row 7).
+    fn camera() -> Camera {
+        Camera {
+            position: Vec3::new(15.5, 7.5, 10.0),
+            screen: Screen {
+                left: 0.0,
+                right: 31.0,
+                top: 15.0,
+                bottom: 0.0,
+            },
+            width: 32,
+            height: 16,
+        }
+    }
+
+    /// A sphere of radius 0.3 on the screen, centred where pixel (`row`, `col`)
+    /// looks.
+    fn on_screen(row: f64, col: f64) -> Object {
+        ball(col, 15.0 - row, 0.0, 0.3)
+    }
+
+    /// The four spheres of the tests: in the top-left tile; 0.7 to the right of
+    /// the planes between the top tiles (0.4 clear of it); 0.7 below the plane
+    /// between the left tiles; on the corner of all four tiles.
+    fn spheres() -> Vec<Object> {
+        vec![
+            on_screen(3.0, 4.0),
+            on_screen(3.0, 16.2),
+            on_screen(8.2, 4.0),
+            on_screen(7.5, 15.5),
+        ]
+    }
+
+    #[test]
+    fn a_tile_lists_the_spheres_in_its_pyramid_and_no_other() {
+        let masks = TileMasks::new(&camera(), &spheres());
+        // Pixels at the corners of each tile, with the mask of its tile: the
+        // sphere inside it and the one on the shared corner.
+        for (pixels, mask) in [
+            ([(0, 0), (7, 15)], 0b1001),
+            ([(0, 16), (7, 31)], 0b1010),
+            ([(8, 0), (15, 15)], 0b1100),
+            ([(8, 16), (15, 31)], 0b1000),
+        ] {
+            for (row, col) in pixels {
+                assert_eq!(masks.mask(row, col), mask, "pixel ({row}, {col})");
+            }
+        }
+    }
+
+    #[test]
+    fn a_scene_of_64_objects_has_masks_and_one_of_65_has_none() {
+        // The three spheres of one tile each, then the corner sphere until there
+        // are 64: the top-right tile still leaves out objects 0 and 2.
+        let mut objects = spheres();
+        objects.resize(64, on_screen(7.5, 15.5));
+        let masks = TileMasks::new(&camera(), &objects);
+        assert_eq!(masks.mask(0, 16), EVERY & !0b101);
+        // More objects than a mask has bits: every object, everywhere.
+        objects.push(on_screen(7.5, 15.5));
+        let masks = TileMasks::new(&camera(), &objects);
+        assert_eq!(masks.mask(0, 16), EVERY);
+    }
+}

@@ -247,6 +247,132 @@ mod tests {
         (near <= far).then_some(near)
     }
 
+    /// What the walk asks of a search, written down: the objects it is given to
+    /// test, in order. Every lane searches until `stop_after_first` ends the
+    /// search at the first object (as a shadow search ends once every lane is
+    /// blocked); every lane's limit is `limit`, which becomes `limit_after_first`
+    /// once an object has been tested (as a nearest search's limit shrinks to its
+    /// first hit).
+    struct Log {
+        tested: Vec<usize>,
+        limit: f64,
+        limit_after_first: f64,
+        stop_after_first: bool,
+    }
+
+    impl Log {
+        fn new(limit: f64, limit_after_first: f64, stop_after_first: bool) -> Log {
+            Log {
+                tested: Vec::new(),
+                limit,
+                limit_after_first,
+                stop_after_first,
+            }
+        }
+    }
+
+    impl PacketSearch for Log {
+        fn active(&self) -> u32 {
+            match self.stop_after_first && !self.tested.is_empty() {
+                true => 0,
+                false => ALL,
+            }
+        }
+        fn limits(&self) -> F64s {
+            F64s::splat(self.limit)
+        }
+        fn test(&mut self, index: usize) {
+            self.tested.push(index);
+            self.limit = self.limit_after_first;
+        }
+        fn test_sphere(&mut self, index: usize, _ball: &[f64; 4]) {
+            self.test(index);
+        }
+    }
+
+    /// Two groups of four spheres (radius 0.4, a leaf each: `LEAF` is 4), around
+    /// x = −10 (objects 0 to 3) and x = +10 (objects 4 to 7), and the objects the
+    /// walk gives `search` for four rays from (`x`, 0, 0) along (`dx`, 0, 0).
+    fn walk_two_groups(x: f64, dx: f64, search: &mut Log) {
+        let mut objects = Vec::new();
+        for centre in [-10.0, 10.0] {
+            for (y, z) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
+                objects.push(ball(centre, y, z, 0.4));
+            }
+        }
+        let bvh = Bvh::build(&objects);
+        assert_eq!(crate::bvh::LEAF, 4, "one leaf per group");
+        let origin = V3::<f64>::splat(Vec3::new(x, 0.0, 0.0));
+        let direction = V3::<f64>::splat(Vec3::new(dx, 0.0, 0.0));
+        bvh.search_packet(&origin, &direction, search);
+    }
+
+    /// The objects of the group around `centre` (−10 or +10).
+    fn group(centre: f64) -> Vec<usize> {
+        if centre < 0.0 {
+            vec![0, 1, 2, 3]
+        } else {
+            vec![4, 5, 6, 7]
+        }
+    }
+
+    fn sorted(mut v: Vec<usize>) -> Vec<usize> {
+        v.sort_unstable();
+        v
+    }
+
+    // From ±15 the origins lie within the tree's fast reach (twice the largest
+    // coordinate, 10.4) and the boxes are tested in float32; from ±100 in float64.
+    const FROM: [f64; 2] = [15.0, 100.0];
+
+    #[test]
+    fn the_walk_enters_the_nearer_child_first() {
+        // Rays along the x axis meet the group on their side first: its leaf is
+        // walked first, the other after it, and every object once.
+        for d in FROM {
+            for side in [-1.0, 1.0] {
+                let mut log = Log::new(f64::INFINITY, f64::INFINITY, false);
+                walk_two_groups(side * d, -side, &mut log);
+                let (near, far) = (group(side), group(-side));
+                assert_eq!(sorted(log.tested[..4].to_vec()), near, "from {}", side * d);
+                assert_eq!(sorted(log.tested[4..].to_vec()), far, "from {}", side * d);
+            }
+        }
+    }
+
+    #[test]
+    fn a_box_beyond_every_lanes_limit_is_not_entered() {
+        // From −d the near group's boxes lie at t from d − 10.4 to d − 9.6, the far
+        // group's from d + 9.6: once the first object sets every limit to d, the
+        // far leaf (left on the stack when the walk chose the near one) is skipped.
+        for d in FROM {
+            let mut log = Log::new(f64::INFINITY, d, false);
+            walk_two_groups(-d, 1.0, &mut log);
+            assert_eq!(sorted(log.tested), group(-1.0), "from {}", -d);
+        }
+    }
+
+    #[test]
+    fn a_box_behind_the_origin_is_not_entered() {
+        // From the origin along +x the group around x = −10 is behind every ray.
+        for dx in [1.0, -1.0] {
+            let mut log = Log::new(f64::INFINITY, f64::INFINITY, false);
+            walk_two_groups(0.0, dx, &mut log);
+            assert_eq!(sorted(log.tested), group(dx), "along {dx}");
+        }
+    }
+
+    #[test]
+    fn the_walk_stops_once_no_lane_is_searching() {
+        // A shadow search ends when every lane is blocked: the first object tested
+        // blocks them all here, and the walk asks for no other, in its leaf or out.
+        for d in FROM {
+            let mut log = Log::new(f64::INFINITY, f64::INFINITY, true);
+            walk_two_groups(-d, 1.0, &mut log);
+            assert_eq!(log.tested.len(), 1, "from {}: {:?}", -d, log.tested);
+        }
+    }
+
     proptest::proptest! {
         #![proptest_config({
             let cases: u32 = std::env::var("RAYSTEP_PROPTEST_CASES")

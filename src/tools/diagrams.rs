@@ -2256,4 +2256,248 @@ mod tests {
         assert!(svg.contains("100,040,004 before rounding"));
         assert!(svg.contains("So Δ = 0 (not above 0): a miss. Before rounding, Δ = 4: a hit."));
     }
+
+    /// The text of every label of `svg`, without its markup: `<text …>*t* = 4</text>`
+    /// is "t = 4".
+    fn labels(svg: &str) -> Vec<String> {
+        svg.split("<text ")
+            .skip(1)
+            .map(|element| {
+                let inner = &element[element.find('>').unwrap() + 1..];
+                let inner = &inner[..inner.find("</text>").unwrap()];
+                let mut plain = String::new();
+                let mut in_tag = false;
+                for ch in inner.chars() {
+                    match ch {
+                        '<' => in_tag = true,
+                        '>' => in_tag = false,
+                        _ if !in_tag => plain.push(ch),
+                        _ => {}
+                    }
+                }
+                plain
+                    .replace("&gt;", ">")
+                    .replace("&lt;", "<")
+                    .replace("&amp;", "&")
+            })
+            .collect()
+    }
+
+    fn has_label(svg: &str, wanted: &str) -> bool {
+        labels(svg).iter().any(|l| l == wanted)
+    }
+
+    /// `(x1, y1, x2, y2)` of every `<line>` drawn with `stroke` at `width`.
+    fn lines_with(svg: &str, stroke: &str, width: &str) -> Vec<(f64, f64, f64, f64)> {
+        let pen = format!(r#" stroke="{stroke}" stroke-width="{width}""#);
+        svg.lines()
+            .filter(|l| l.starts_with("<line") && l.contains(&pen))
+            .map(|element| {
+                let value = |name: &str| -> f64 {
+                    let v = element.split(&format!(r#" {name}=""#)).nth(1).unwrap();
+                    v.split('"').next().unwrap().parse().unwrap()
+                };
+                (value("x1"), value("y1"), value("x2"), value("y2"))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn chapter_2_labels_say_the_captions_grid_pixel_and_screen_corners() {
+        // The caption: "the grid of a 6 × 4 image … pixel (row 1, column 4)"; the
+        // seed scene's default screen: x from −1 to 1, y ±200/300.
+        let svg = drawn("ch02/camera");
+        assert!(svg.contains("<title>The camera, the screen at z = 0 with the grid of a 6 × 4 image, and the ray of pixel (row 1, column 4)</title>"));
+        assert!(
+            has_label(&svg, "pixel (row i = 1, column j = 4)"),
+            "{:?}",
+            labels(&svg)
+        );
+        assert!(
+            has_label(&svg, "(left, top) = (−1, 0.667)"),
+            "{:?}",
+            labels(&svg)
+        );
+        assert!(
+            has_label(&svg, "(right, bottom) = (1, −0.667)"),
+            "{:?}",
+            labels(&svg)
+        );
+    }
+
+    #[test]
+    fn chapter_3_the_touching_ray_meets_the_sphere_once_at_its_radius_end() {
+        // The ray at height 1.5 along +x from x = 0 touches the sphere of radius 1.5
+        // around (4, 0, 0) at (4, 1.5, 0): t = 4, the top of the radius drawn.
+        let svg = drawn("ch03/discriminant");
+        assert!(has_label(&svg, "t = 4"), "{:?}", labels(&svg));
+        // The drawing puts (x, y) at (52 + 70x, 215 − 70y): C at (332, 215), the
+        // touching point at (332, 110).
+        let radius = lines_with(&svg, GREY, "1.3");
+        assert_eq!(radius, [(332.0, 215.0, 332.0, 110.0)]);
+    }
+
+    #[test]
+    fn chapter_4_each_shadow_ray_starts_where_its_panel_says() {
+        // Left, from P′ = P + step·N; right, from the point a rounding error inside.
+        // The drawing puts P at (165, 300) on the left, (490, 300) on the right, 36
+        // pixels a unit, y up.
+        let p = step_picture();
+        let svg = drawn("ch04/step");
+        let starts: Vec<(f64, f64)> = lines_with(&svg, ORANGE, "2.2")
+            .iter()
+            .map(|&(x1, y1, _, _)| (x1, y1))
+            .collect();
+        let drawn_at = |anchor: f64, v: Vec3| {
+            let d = v - p.point;
+            (n(anchor + 36.0 * d.x), n(300.0 - 36.0 * d.y))
+        };
+        let starts: Vec<(String, String)> = starts.iter().map(|&(x, y)| (n(x), n(y))).collect();
+        assert_eq!(
+            starts,
+            [drawn_at(165.0, p.shifted), drawn_at(490.0, p.inside)]
+        );
+        // Right: the × where it meets its own surface, ahead of the point inside
+        // (the positive root), towards the light.
+        let (_, ahead) = p.inside_roots;
+        assert!(ahead > 0.0);
+        let crossing = Ray::towards(p.inside, p.light).at(ahead);
+        let d = crossing - p.point;
+        let (cx, cy) = (490.0 + 36.0 * d.x, 300.0 - 36.0 * d.y);
+        let cross = lines_with(&svg, RED, "2.5");
+        assert_eq!(cross.len(), 2, "{cross:?}");
+        for (x1, y1, x2, y2) in cross {
+            let (mx, my) = ((x1 + x2) / 2.0, (y1 + y2) / 2.0);
+            assert!(
+                (mx - cx).abs() <= 0.1 && (my - cy).abs() <= 0.1,
+                "× at ({mx}, {my}), not ({cx}, {cy})"
+            );
+        }
+    }
+
+    #[test]
+    fn chapter_5_the_normal_is_a_quarter_of_the_way_from_the_camera_to_the_light() {
+        // N = normalize(¾·ĉ + ¼·l̂) for the unit directions ĉ, l̂ from the centre to
+        // the camera and to the light: then |N × ĉ| / |N × l̂| = ¼ / ¾ (a sum of two
+        // unit vectors weighted a and b makes angles whose sines are as b to a).
+        let scene = seed();
+        let p = half_vector_picture(&scene).unwrap();
+        let c = (scene.camera - p.sphere.center).normalize();
+        let l = (scene.light.position - p.sphere.center).normalize();
+        let ratio = p.normal.cross(c).length() / p.normal.cross(l).length();
+        assert!((ratio - 1.0 / 3.0).abs() < 1e-12, "{ratio}");
+        assert!(p.normal.dot(c) > p.normal.dot(l), "nearer the camera");
+    }
+
+    #[test]
+    fn chapter_6_says_d_dot_n_is_minus_0_6() {
+        // d = (0.8, −0.6), N = (0, 1): d·N = −0.6.
+        let svg = drawn("ch06/mirror");
+        assert!(has_label(&svg, "d·N = −0.6"), "{:?}", labels(&svg));
+    }
+
+    #[test]
+    fn chapter_7_marks_the_sag_at_100_and_keys_each_row_as_the_caption_says() {
+        // The caption: "the sag … 0.56 at a distance of 100"; rows 100 and 101 meet
+        // the true plane but pass over the fake floor, row 102 meets both.
+        let svg = drawn("ch07/sag");
+        assert!(has_label(&svg, "0.56 lower at 100"), "{:?}", labels(&svg));
+        let chapter = std::fs::read_to_string(root().join("chapters/07-plane.md")).unwrap();
+        assert!(chapter.contains("0.56 at a distance of 100"));
+        let all = labels(&svg);
+        let key = |row: u32| {
+            all.iter()
+                .find(|l| l.starts_with(&format!("row {row}: ")))
+                .unwrap_or_else(|| panic!("row {row}: {all:?}"))
+                .clone()
+        };
+        for row in [100, 101] {
+            let line = key(row);
+            assert!(
+                line.starts_with(&format!("row {row}: the true plane at "))
+                    && line.ends_with(", over the fake floor"),
+                "{line}"
+            );
+        }
+        assert!(
+            key(102).starts_with("row 102: the fake floor at "),
+            "{}",
+            key(102)
+        );
+        assert!(key(102).contains(", the true plane at "), "{}", key(102));
+        assert_eq!(key(99), "row 99: sky over both floors");
+    }
+
+    #[test]
+    fn chapter_9_float32_numbers_near_b_squared_are_8_apart() {
+        // 2²⁶ ≤ 100,040,000 < 2²⁷: float32's 24 bits leave steps of 2³ there, as the
+        // chapter's alt text says.
+        let svg = drawn("ch09/cancellation");
+        assert!(labels(&svg).iter().any(|l| l.starts_with(
+            "float32 numbers here are 8 apart: b² rounds to 100,040,000, and 4c is 100,040,000."
+        )));
+        let chapter = std::fs::read_to_string(root().join("chapters/09-methods.md")).unwrap();
+        assert!(chapter.contains("near 100,040,000 float32 numbers are 8 apart"));
+    }
+
+    #[test]
+    fn chapter_9_bound_the_bounds_panel_passes_over_up_to_the_0_44_the_chapter_quotes() {
+        // "A shadow ray that starts h above a sphere passes over it for |L·N| up to
+        // about √(2h/r) …: 0.44 on `tiny-far` in float32 (the diagram …)".
+        let chapter = std::fs::read_to_string(root().join("chapters/09-methods.md")).unwrap();
+        assert!(chapter.contains("0.44 on `tiny-far` in float32 (the\ndiagram"));
+        let svg = drawn("ch09/bound");
+        let all = labels(&svg);
+        let scene_at_left = all.iter().position(|l| l == "--offset scene").unwrap();
+        let auto_at_right = all.iter().position(|l| l == "--offset auto").unwrap();
+        assert!(scene_at_left < auto_at_right, "{all:?}");
+        let reaches: Vec<&String> = all
+            .iter()
+            .filter(|l| l.starts_with("passes over up to |L·N| = "))
+            .collect();
+        assert_eq!(reaches.len(), 2, "{all:?}");
+        assert_eq!(reaches[1], "passes over up to |L·N| = 0.44");
+        // Each panel's reach is about √(2h/r) for its own step: exactly
+        // √(2x + x²)/(1 + x) for x = h/r, between √(2x)/(1 + x) and √(2x). The
+        // scene-sized step is the larger: it reaches further.
+        let p = bound_picture(&scene_at(root(), TINY_FAR).unwrap()).unwrap();
+        let r = p.sphere.radius;
+        for (h, reach) in p.steps.iter().zip(p.reach) {
+            let estimate = (2.0 * h / r).sqrt();
+            let below = estimate / (1.0 + h / r);
+            assert!(reach < estimate && reach > below, "{h}: {reach} {estimate}");
+        }
+        assert!(p.steps[0] > p.steps[1] && p.reach[0] > p.reach[1], "{p:?}");
+    }
+
+    #[test]
+    fn an_arc_turning_clockwise_on_the_page_has_svgs_sweep_flag_1() {
+        // From the right (1, 0) to down (0, 1), y down: a quarter turn clockwise on
+        // the page, which SVG calls the positive-angle direction, sweep-flag 1; and
+        // back the other way, 0.
+        let mut svg = Svg::new(100, 100, "arcs");
+        svg.arc(
+            px(50.0, 50.0),
+            10.0,
+            px(1.0, 0.0),
+            px(0.0, 1.0),
+            pen(INK, 1.0),
+        );
+        svg.arc(
+            px(50.0, 50.0),
+            10.0,
+            px(0.0, 1.0),
+            px(1.0, 0.0),
+            pen(INK, 1.0),
+        );
+        let body = svg.finish();
+        assert!(
+            body.contains(r#"d="M 60 50 A 10 10 0 0 1 50 60""#),
+            "{body}"
+        );
+        assert!(
+            body.contains(r#"d="M 50 60 A 10 10 0 0 0 60 50""#),
+            "{body}"
+        );
+    }
 }

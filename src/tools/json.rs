@@ -95,3 +95,30 @@ pub fn scene_json(scene: &Scene, name: &str, listed: bool) -> serde_json::Value 
     }
     described
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// README.md: every object has `"schema": 1`, keys in alphabetical order;
+    /// `pretty` false is one line, true is indented over several.
+    #[test]
+    fn json_text_adds_schema_1_and_sorts_the_keys_on_one_line_or_indented() {
+        let value = serde_json::json!({ "zeta": 2, "alpha": [1, 2] });
+        assert_eq!(
+            json_text(&value, false),
+            r#"{"alpha":[1,2],"schema":1,"zeta":2}"#
+        );
+        assert_eq!(
+            json_text(&value, true),
+            "{\n  \"alpha\": [\n    1,\n    2\n  ],\n  \"schema\": 1,\n  \"zeta\": 2\n}"
+        );
+    }
+
+    /// A value that is not an object is kept, under `data`, beside the schema.
+    #[test]
+    fn json_text_puts_a_value_that_is_no_object_under_data() {
+        assert_eq!(json_text(&[1, 2], false), r#"{"data":[1,2],"schema":1}"#);
+        assert_eq!(json_text(&"x", false), r#"{"data":"x","schema":1}"#);
+    }
+}
