@@ -16,6 +16,15 @@ fn main() -> ExitCode {
         // disk) is an error, as for any output; a closed pipe is not.
         Err(e) => {
             use std::io::Write;
+            if let Some(scene) = scene_given_as_command(&e) {
+                let said = format!(
+                    "error: `{scene}` is not a command; to render a scene file, name the \
+                     command first: `raystep stages {scene}` (every stage) or `raystep \
+                     render {scene}`"
+                );
+                eprintln!("{}", raystep::error::for_terminal(&said));
+                return ExitCode::from(raystep::error::USER_ERROR as u8);
+            }
             let printed = e.print().and_then(|()| std::io::stdout().flush());
             return match printed {
                 Err(io) if io.kind() != std::io::ErrorKind::BrokenPipe => {
@@ -44,4 +53,15 @@ fn main() -> ExitCode {
             ExitCode::from(error.exit_code())
         }
     }
+}
+
+/// The scene file a command line gave where the command goes (`raystep
+/// seed.toml`), which clap calls an unrecognised subcommand: the first argument
+/// that is not a flag, if it names a `.toml` file or an existing file.
+fn scene_given_as_command(e: &clap::Error) -> Option<String> {
+    if e.kind() != clap::error::ErrorKind::InvalidSubcommand {
+        return None;
+    }
+    let first = std::env::args().skip(1).find(|a| !a.starts_with('-'))?;
+    (first.ends_with(".toml") || std::path::Path::new(&first).is_file()).then_some(first)
 }

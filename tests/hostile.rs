@@ -166,6 +166,12 @@ fn fixtures() -> &'static Path {
         let dir = tempfile::tempdir().unwrap();
         let at = |name: &str| dir.path().join(name);
         std::fs::write(at("binary.toml"), [0xff, 0xfe, 0x00, 0x12, 0x9c]).unwrap();
+        // A scene saved as Latin-1: "café" in a comment on line 2.
+        std::fs::write(
+            at("latin1.toml"),
+            b"[camera]\nposition = [0, 0, 1] # caf\xe9\n",
+        )
+        .unwrap();
         std::fs::write(at("empty.toml"), "").unwrap();
         // 100 MB that take no room: the file is sparse.
         let huge = std::fs::File::create(at("huge.toml")).unwrap();

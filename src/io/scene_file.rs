@@ -115,9 +115,25 @@ pub fn load_sized(path: &Path, size: SizeOverride) -> Result<Scene, Error> {
     };
     let cannot = |e: std::io::Error| fail(format!("cannot read the scene file: {e}"));
     let reader: Box<dyn std::io::Read> = if is_stdin(path) {
+        use std::io::IsTerminal;
+        if std::io::stdin().is_terminal() {
+            eprintln!("reading the scene from standard input (end it with Ctrl-D)");
+        }
         Box::new(std::io::stdin().lock())
     } else {
-        let meta = std::fs::metadata(path).map_err(cannot)?;
+        let meta = std::fs::metadata(path).map_err(|e| {
+            // The name the status line gives the built-in scene, tried outside
+            // the repository.
+            let seed = SEED_NAME.split(' ').next().map(Path::new);
+            if e.kind() == std::io::ErrorKind::NotFound && Some(path) == seed {
+                fail(format!(
+                    "cannot read the scene file: {e}; the built-in scene needs no file: \
+                     leave the scene out (`raystep render`)"
+                ))
+            } else {
+                cannot(e)
+            }
+        })?;
         if meta.is_dir() {
             return Err(fail(
                 "is a folder; give the path of a .toml scene file".into(),
@@ -138,8 +154,21 @@ pub fn load_sized(path: &Path, size: SizeOverride) -> Result<Scene, Error> {
             "is larger than {MAX_FILE_BYTES} bytes, the most a scene file may be"
         )));
     }
-    let text = String::from_utf8(bytes)
-        .map_err(|_| fail("is not a text file (not UTF-8); a scene file is TOML text".into()))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
+        let line_start = valid.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+        let column = String::from_utf8_lossy(&valid[line_start..])
+            .chars()
+            .count()
+            + 1;
+        fail(format!(
+            "is not a text file (not UTF-8): line {line}, column {column} holds the byte \
+             {:#04x}, which UTF-8 does not allow there; a scene file is TOML text: save it \
+             as UTF-8",
+            e.as_bytes()[valid.len()]
+        ))
+    })?;
     parse_sized(&text, &file, size)
 }
 

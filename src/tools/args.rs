@@ -330,6 +330,35 @@ pub struct StagesArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
     pub files: FileArgs,
+    /// `render`'s flags, which `stages` does not take (hidden): given, each is
+    /// refused with the command that takes it, where clap would tip `-- --stage`.
+    #[arg(long, hide = true, value_name = "STAGE")]
+    pub stage: Option<String>,
+    /// See `stage`.
+    #[arg(long, hide = true, value_name = "STAGE")]
+    pub without: Vec<String>,
+    /// See `stage`.
+    #[arg(long, hide = true)]
+    pub json: bool,
+}
+
+impl StagesArgs {
+    /// Refuse `render`'s flags, each with the command that takes it.
+    pub fn refuse_render_flags(&self) -> Result<(), Error> {
+        let flag = if self.stage.is_some() {
+            "--stage"
+        } else if !self.without.is_empty() {
+            "--without"
+        } else if self.json {
+            "--json"
+        } else {
+            return Ok(());
+        };
+        Err(Error::Usage(format!(
+            "stages renders every stage, each into its own folder, and takes no {flag}; \
+             `raystep render {flag} …` renders one set of stages"
+        )))
+    }
 }
 
 /// How the files of a render are encoded (`render`, `stages`).
@@ -486,6 +515,9 @@ impl StagesArgs {
             rules: RuleArgs::default(),
             out: PathBuf::from("out"),
             files: FileArgs::default(),
+            stage: None,
+            without: Vec::new(),
+            json: false,
         }
     }
 }

@@ -254,6 +254,7 @@ fn render_with(
 pub const CONTACT_SHEET: &str = "contact-sheet.png";
 
 fn stages(args: StagesArgs) -> Result<(), Error> {
+    args.refuse_render_flags()?;
     let (mut scene, name) = load_scene(&args.scene)?;
     let base = args.rules.apply(&mut scene, &name, Stages::ALL)?;
     // Every file of every stage is renamed into place at the end, together: an

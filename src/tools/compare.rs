@@ -96,6 +96,17 @@ pub fn read_beauty(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>), Error> 
         message,
     };
     let not_exr = |e: exr::error::Error| fail(format!("cannot read it as an EXR file: {e}"));
+    if path.as_os_str() == "-" {
+        return Err(fail(
+            "diff reads two EXR files by name; it does not read standard input".into(),
+        ));
+    }
+    if path.is_dir() {
+        return Err(fail(format!(
+            "is a folder; diff compares two EXR files: {}",
+            path.join(crate::io::output::EXR_FILE).display()
+        )));
+    }
     let meta = exr::meta::MetaData::read_from_file(path, false).map_err(not_exr)?;
     let largest = meta
         .headers
