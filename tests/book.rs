@@ -943,6 +943,46 @@ fn chapter_12_names_every_file_that_names_the_stages() {
     assert!(naming >= 10, "{naming} files of src/ name the stages");
 }
 
+/// Chapter 12's exercise 2, done: `chapters/answers/occlusion-stage.patch` makes
+/// the stage real as the chapter's table says, and the chapter lists the tests
+/// that failed with it. Every file the patch changes is named in the chapter, and
+/// the patch must still apply to the code of today: when it stops applying, the
+/// list may be stale. Make the stage again on the new code (`git apply -3` does
+/// most of it), run the tests as the chapter says, correct its list, and commit
+/// the new patch.
+#[test]
+fn chapter_12_exercise_2s_answer_applies_to_the_code_of_today() {
+    let patch = "chapters/answers/occlusion-stage.patch";
+    let text = std::fs::read_to_string(root().join(patch)).unwrap();
+    let chapter = chapter("12");
+    assert!(chapter.contains(patch), "chapter 12 names {patch}");
+    let changed: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("+++ b/"))
+        .collect();
+    assert!(changed.len() >= 15, "{changed:?}");
+    for file in &changed {
+        assert!(
+            chapter.contains(&format!("`{file}`")),
+            "the answer changes {file}, which chapter 12 does not name"
+        );
+    }
+    let git = std::process::Command::new("git")
+        .args(["apply", "--check", patch])
+        .current_dir(root())
+        .output()
+        .map_err(|e| format!("git ({e})"));
+    let Some(git) = common::required(git, "applying chapter 12's answer") else {
+        return;
+    };
+    assert!(
+        git.status.success(),
+        "{patch} no longer applies, so chapter 12's list of failing tests may be \
+         stale: {}",
+        String::from_utf8_lossy(&git.stderr)
+    );
+}
+
 #[test]
 fn no_table_row_shows_more_than_two_pictures() {
     // At the book's width of about 750 px, three pictures in a row shrink below
