@@ -170,6 +170,24 @@ impl Pending {
                 "it is a file, not a folder; give --out a folder".into(),
             ));
         }
+        if dir.as_os_str() == "-" {
+            return Err(fail(
+                "raystep writes a folder of files, not standard output; give --out a \
+                 folder (./- for one named -)"
+                    .into(),
+            ));
+        }
+        // A file where a folder above it should be: `--out notes.txt/render`.
+        if let Some(file) = dir
+            .ancestors()
+            .skip(1)
+            .find(|a| !a.as_os_str().is_empty() && a.exists() && !a.is_dir())
+        {
+            return Err(fail(format!(
+                "{} is a file, not a folder, so no folder can be made in it",
+                file.display()
+            )));
+        }
         let missing: Vec<&Path> = dir
             .ancestors()
             .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
@@ -181,7 +199,21 @@ impl Pending {
                     self.created.push(folder.to_path_buf());
                 }
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && folder.is_dir() => {}
-                Err(e) => return Err(fail(format!("cannot create the output folder: {e}"))),
+                Err(e) => {
+                    // A parent that exists but takes no new folder (/proc, say)
+                    // answers "not found", which reads as if the folder should exist.
+                    let parent = folder.parent().filter(|p| !p.as_os_str().is_empty());
+                    let why = match parent {
+                        Some(p) if e.kind() == std::io::ErrorKind::NotFound && p.is_dir() => {
+                            format!("{} does not let a folder be made in it ({e})", p.display())
+                        }
+                        _ => e.to_string(),
+                    };
+                    return Err(fail(format!(
+                        "cannot create the output folder {}: {why}",
+                        folder.display()
+                    )));
+                }
             }
         }
         let held = fs::File::open(dir).ok();
