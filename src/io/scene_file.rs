@@ -454,8 +454,23 @@ fn toml_error(e: &toml::de::Error, text: &str) -> String {
     };
     let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
     let line_end = text[start..].find('\n').map_or(text.len(), |i| start + i);
-    let what = brackets(&what, &text[line_start..line_end]).unwrap_or_else(|| with_hint(what));
+    let line = &text[line_start..line_end];
+    let what = whole_number_range(&what, line);
+    let what = brackets(&what, line).unwrap_or_else(|| with_hint(what));
     pointed(text, start..span.end, &what)
+}
+
+/// A whole number of the wrong kind (`width = 300.0`) told the range its key
+/// accepts, not its type's: the image's sides 1 to [`MAX_SIDE`], `max_depth` 1
+/// to [`MAX_DEPTH`] (the key read from the start of `line`).
+fn whole_number_range(what: &str, line: &str) -> String {
+    let key = line.split('=').next().unwrap_or("").trim();
+    let range = match key {
+        "width" | "height" => format!("from 1 to {MAX_SIDE}"),
+        "max_depth" => format!("from 1 to {MAX_DEPTH}"),
+        _ => return what.to_string(),
+    };
+    what.replace("from 0 to 4294967295", &range)
 }
 
 /// `what`, said of the text at `span` of `text`: "line L, column C: what", the
