@@ -606,7 +606,36 @@ pub fn load_scene(args: &SceneArgs) -> Result<(Scene, String), Error> {
         None => scene_file::parse_sized(scene_file::SEED_TOML, scene_file::SEED_NAME, size)?,
     };
     warn_if_empty(&scene, &scene_name(args));
+    warn_if_stretched(&scene, &scene_name(args));
     Ok((scene, scene_name(args)))
+}
+
+/// `v` to four decimal places, without trailing zeros: 2, 0.5334, 133334.6667.
+fn four_places(v: f64) -> String {
+    format!("{}", (v * 1e4).round() / 1e4)
+}
+
+/// A `[screen]` whose shape is not the image's: valid (chapter 2's second
+/// exercise makes one), but the pixels are not square and the picture comes out
+/// stretched, which a reader should hear of. Shapes within 1 % of each other pass.
+pub fn warn_if_stretched(scene: &Scene, name: &str) {
+    let Some(screen) = scene.screen else {
+        return;
+    };
+    let across = (screen.right - screen.left) / f64::from(scene.width);
+    let up = (screen.top - screen.bottom) / f64::from(scene.height);
+    if (up / across - 1.0).abs() > 0.01 {
+        let said = format!(
+            "warning: {name}: the screen, {} × {}, is not the shape of the image, {} × {} \
+             pixels: the pixels are not square, so the picture comes out stretched (a \
+             [screen] of the image's shape, or none, keeps them square)",
+            four_places(screen.right - screen.left),
+            four_places(screen.top - screen.bottom),
+            scene.width,
+            scene.height
+        );
+        eprintln!("{}", crate::error::for_terminal(&said));
+    }
 }
 
 /// A scene without objects is valid, but almost surely not what was meant.

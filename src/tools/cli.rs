@@ -825,6 +825,7 @@ fn check(args: &CheckArgs) -> Result<(), Error> {
     let name = scene_file::display_name(path);
     let scene = scene_file::load(path)?;
     warn_if_empty(&scene, &name);
+    crate::tools::args::warn_if_stretched(&scene, &name);
     if args.json {
         return say_json(scene_json(&scene, &name, true), true);
     }
