@@ -97,6 +97,15 @@ pub fn for_terminal(text: &str) -> Cow<'_, str> {
         .collect()
 }
 
+/// Write `text` as one line on standard error, through [`for_terminal`]: every
+/// message, warning and status line raystep prints there. A line that cannot be
+/// written is dropped (`eprintln!` would panic on a closed standard error).
+pub fn to_stderr(text: std::fmt::Arguments) {
+    use std::io::Write;
+    let text = text.to_string();
+    let _ = writeln!(std::io::stderr().lock(), "{}", for_terminal(&text));
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -17,12 +17,11 @@ fn main() -> ExitCode {
         Err(e) => {
             use std::io::Write;
             if let Some(scene) = scene_given_as_command(&e) {
-                let said = format!(
+                raystep::error::to_stderr(format_args!(
                     "error: `{scene}` is not a command; to render a scene file, name the \
                      command first: `raystep stages {scene}` (every stage) or `raystep \
                      render {scene}`"
-                );
-                eprintln!("{}", raystep::error::for_terminal(&said));
+                ));
                 return ExitCode::from(raystep::error::USER_ERROR as u8);
             }
             let printed = e.print().and_then(|()| std::io::stdout().flush());
@@ -32,10 +31,7 @@ fn main() -> ExitCode {
                         path: "standard output".into(),
                         message: io.to_string(),
                     };
-                    eprintln!(
-                        "error: {}",
-                        raystep::error::for_terminal(&error.to_string())
-                    );
+                    raystep::error::to_stderr(format_args!("error: {error}"));
                     ExitCode::from(error.exit_code())
                 }
                 _ => ExitCode::from(e.exit_code() as u8),
@@ -46,22 +42,22 @@ fn main() -> ExitCode {
     match execute(cli) {
         Ok(code) => ExitCode::from(code),
         Err(error) => {
-            eprintln!(
-                "error: {}",
-                raystep::error::for_terminal(&error.to_string())
-            );
+            raystep::error::to_stderr(format_args!("error: {error}"));
             ExitCode::from(error.exit_code())
         }
     }
 }
 
 /// The scene file a command line gave where the command goes (`raystep
-/// seed.toml`), which clap calls an unrecognised subcommand: the first argument
-/// that is not a flag, if it names a `.toml` file or an existing file.
+/// seed.toml`): the word clap calls an unrecognised subcommand, if it names a
+/// `.toml` file or an existing file.
 fn scene_given_as_command(e: &clap::Error) -> Option<String> {
-    if e.kind() != clap::error::ErrorKind::InvalidSubcommand {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    if e.kind() != ErrorKind::InvalidSubcommand {
         return None;
     }
-    let first = std::env::args().skip(1).find(|a| !a.starts_with('-'))?;
-    (first.ends_with(".toml") || std::path::Path::new(&first).is_file()).then_some(first)
+    let Some(ContextValue::String(word)) = e.get(ContextKind::InvalidSubcommand) else {
+        return None;
+    };
+    (word.ends_with(".toml") || std::path::Path::new(word).is_file()).then(|| word.clone())
 }

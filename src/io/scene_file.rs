@@ -117,7 +117,9 @@ pub fn load_sized(path: &Path, size: SizeOverride) -> Result<Scene, Error> {
     let reader: Box<dyn std::io::Read> = if is_stdin(path) {
         use std::io::IsTerminal;
         if std::io::stdin().is_terminal() {
-            eprintln!("reading the scene from standard input (end it with Ctrl-D)");
+            crate::error::to_stderr(format_args!(
+                "reading the scene from standard input (end it with Ctrl-D)"
+            ));
         }
         Box::new(std::io::stdin().lock())
     } else {

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 
 use crate::accel::Accel;
-use crate::error::Error;
+use crate::error::{to_stderr, Error};
 use crate::io::output::{ExrCompression, PngEncoding};
 use crate::io::scene_file::{self, check_max_depth, SizeOverride};
 use crate::real::Precision;
@@ -242,11 +242,11 @@ pub struct SceneArgs {
     pub scene: Option<PathBuf>,
     /// Image width in pixels (overrides the scene's [image] width; 1 to 16384, and
     /// at most 7680 × 4320 pixels in all: about 64 bytes of memory each).
-    #[arg(long, allow_negative_numbers = true, value_parser = whole::<16384>)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<{ scene_file::MAX_SIDE }>)]
     pub width: Option<u32>,
     /// Image height in pixels (overrides the scene's [image] height; 1 to 16384, and
     /// at most 7680 × 4320 pixels in all).
-    #[arg(long, allow_negative_numbers = true, value_parser = whole::<16384>)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<{ scene_file::MAX_SIDE }>)]
     pub height: Option<u32>,
 }
 
@@ -276,12 +276,12 @@ pub struct RuleArgs {
     #[arg(long, value_enum, default_value_t = Viewer::Camera)]
     pub viewer: Viewer,
     /// Most segments per pixel path (overrides the scene's render.max_depth; 1 to 64).
-    #[arg(long, allow_negative_numbers = true, value_parser = whole::<64>)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<{ scene_file::MAX_DEPTH }>)]
     pub max_depth: Option<u32>,
     /// Samples per pixel, a square number from 1 to 1024: stratified over an n × n
     /// grid, jittered the same way on every run [default: 1, the tutorial's one ray
     /// per pixel].
-    #[arg(long, allow_negative_numbers = true, value_parser = whole::<1024>)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<{ scene_file::MAX_SPP }>)]
     pub spp: Option<u32>,
     /// End a reflection path once what is left of it cannot move a channel by half
     /// an 8-bit step [default: on; off with --tutorial].
@@ -542,17 +542,18 @@ impl RuleArgs {
         let warnings = crate::io::scene_file::check_precision(scene, precision)
             .map_err(|e| Error::Usage(format!("{name}: --precision {precision}: {e}")))?;
         for warning in warnings {
-            let said = format!("warning: {name}: --precision {precision}: {warning}");
-            eprintln!("{}", crate::error::for_terminal(&said));
+            to_stderr(format_args!(
+                "warning: {name}: --precision {precision}: {warning}"
+            ));
         }
         let method = self.intersect.unwrap_or(base.method);
         if self.accel == Some(Accel::Bvh) && method == Method::Naive {
-            eprintln!(
+            to_stderr(format_args!(
                 "warning: --accel bvh: the textbook quadratic (--intersect naive{}) gets no \
                  BVH, since its false hits far outside a sphere (chapter 9) would fall \
                  outside the boxes; every object is tested, as with --accel off",
                 if self.tutorial { ", by --tutorial" } else { "" }
-            );
+            ));
         }
         Ok(Settings {
             stages,
@@ -625,7 +626,7 @@ pub fn warn_if_stretched(scene: &Scene, name: &str) {
     let across = (screen.right - screen.left) / f64::from(scene.width);
     let up = (screen.top - screen.bottom) / f64::from(scene.height);
     if (up / across - 1.0).abs() > 0.01 {
-        let said = format!(
+        to_stderr(format_args!(
             "warning: {name}: the screen, {} × {}, is not the shape of the image, {} × {} \
              pixels: the pixels are not square, so the picture comes out stretched (a \
              [screen] of the image's shape, or none, keeps them square)",
@@ -633,19 +634,17 @@ pub fn warn_if_stretched(scene: &Scene, name: &str) {
             four_places(screen.top - screen.bottom),
             scene.width,
             scene.height
-        );
-        eprintln!("{}", crate::error::for_terminal(&said));
+        ));
     }
 }
 
 /// A scene without objects is valid, but almost surely not what was meant.
 pub fn warn_if_empty(scene: &Scene, name: &str) {
     if scene.objects.is_empty() {
-        let said = format!(
+        to_stderr(format_args!(
             "warning: {name}: the scene has no [[sphere]] and no [[plane]], so every ray \
              misses and the image is black"
-        );
-        eprintln!("{}", crate::error::for_terminal(&said));
+        ));
     }
 }
 

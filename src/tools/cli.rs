@@ -47,14 +47,8 @@ fn quiet() -> bool {
 /// Write a status line to standard error, unless quiet. A status line that
 /// cannot be written is not an error: the work it reports on is done.
 fn status_line(text: std::fmt::Arguments) {
-    use std::io::Write;
     if !quiet() {
-        let text = text.to_string();
-        let _ = writeln!(
-            std::io::stderr().lock(),
-            "{}",
-            crate::error::for_terminal(&text)
-        );
+        crate::error::to_stderr(text);
     }
 }
 

@@ -92,10 +92,10 @@ pub fn run(args: &ServeArgs, quiet: bool) -> Result<(), Error> {
             })?;
     }
     if !quiet {
-        eprintln!(
+        crate::error::to_stderr(format_args!(
             "serving {} on {url} (127.0.0.1 only); Ctrl-C to stop",
-            crate::error::for_terminal(studio.name())
-        );
+            studio.name()
+        ));
     }
     if args.open {
         open_browser(&url);
@@ -164,7 +164,9 @@ fn open_browser(url: &str) {
         .stderr(std::process::Stdio::null())
         .spawn();
     if let Err(e) = started {
-        eprintln!("warning: cannot start a browser with {opener} ({e}); open {url} by hand");
+        crate::error::to_stderr(format_args!(
+            "warning: cannot start a browser with {opener} ({e}); open {url} by hand"
+        ));
     }
 }
 
