@@ -9,7 +9,7 @@
 
 use rayon::prelude::*;
 
-use crate::accel::{Accel, BVH_FROM};
+use crate::accel::Accel;
 use crate::aov::{FirstHit, Frame, Packets, PixelRecord, Rays};
 use crate::bvh::Bvh;
 use crate::camera::Camera;
@@ -201,14 +201,8 @@ impl<T: Real> Tracer<T> {
     pub fn new(scene: &Scene, settings: &Settings) -> Tracer<T> {
         let objects: Vec<Object<T>> = scene.objects_in_play(settings.stages);
         let spheres = objects.iter().filter(|o| o.role == Role::Sphere).count();
-        // The textbook quadratic reports false hits far outside spheres (chapter
-        // 9); boxes would hide them and change the picture, so it gets no BVH.
-        let tree = match settings.accel {
-            _ if settings.method == Method::Naive => false,
-            Accel::Off => false,
-            Accel::Auto => spheres >= BVH_FROM,
-            Accel::Bvh => true,
-        };
+        // (The textbook quadratic gets no BVH: boxes would hide its false hits.)
+        let tree = settings.accel.builds_bvh(spheres, settings.method);
         let reach = if settings.early_stop {
             reach(&objects, &scene.light, scene.max_depth, settings.stages)
         } else {

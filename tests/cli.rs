@@ -473,6 +473,47 @@ fn size_flags_override_a_size_the_file_gets_wrong() {
 }
 
 #[test]
+fn max_depth_overrides_a_depth_the_file_gets_wrong_as_the_size_flags_do() {
+    let dir = tempfile::tempdir().unwrap();
+    let with_depth = |depth: u32| {
+        scene_with(&format!(
+            "[image]\nwidth = 8\nheight = 6\n[render]\nmax_depth = {depth}\n\
+             [[sphere]]\ncenter = [0, 0, -1]\nradius = 0.7\n\
+             ambient = [0.1, 0, 0]\ndiffuse = [0.7, 0, 0]\n\
+             [[plane]]\npoint = [0, -0.7, 0]\nnormal = [0, 1, 0]\n\
+             ambient = [0.1, 0.1, 0.1]\ndiffuse = [0.6, 0.6, 0.6]\n"
+        ))
+    };
+    std::fs::write(dir.path().join("deep.toml"), with_depth(100)).unwrap();
+    std::fs::write(dir.path().join("two.toml"), with_depth(2)).unwrap();
+    for command in ["render", "stages"] {
+        let out = raystep(
+            dir.path(),
+            &[command, "deep.toml", "--max-depth", "2", "-q"],
+        );
+        assert!(out.status.success(), "{command}: {}", text(&out.stderr));
+    }
+    // The flag's depth is the one rendered: the rays of a file that asks for 2.
+    let rays = |args: &[&str]| {
+        let args = [&["render", "--json", "-q", "--out", "o"], args].concat();
+        json_of(dir.path(), &args)["rays"]["total"]
+            .as_u64()
+            .unwrap()
+    };
+    let two = rays(&["two.toml"]);
+    assert_eq!(rays(&["deep.toml", "--max-depth", "2"]), two);
+    assert!(rays(&["deep.toml", "--max-depth", "1"]) < two);
+    // Without the flag the file's value is still checked, and named.
+    let out = raystep(dir.path(), &["render", "deep.toml", "-q"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("render.max_depth = 100: must be from 1 to 64"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+#[test]
 fn bench_prints_one_json_object_with_the_promised_keys() {
     let dir = tempfile::tempdir().unwrap();
     let json = json_of(

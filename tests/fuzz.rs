@@ -56,9 +56,7 @@ use proptest::test_runner::{Config, TestCaseError, TestRunner};
 use raystep::accel::Accel;
 use raystep::aov::{PixelRecord, NO_OBJECT};
 use raystep::engine::render;
-use raystep::io::scene_file::{
-    check_precision, parse_sized, SizeOverride, MAX_MAGNITUDE, SEED_TOML,
-};
+use raystep::io::scene_file::{check_precision, parse_sized, Overrides, MAX_MAGNITUDE, SEED_TOML};
 use raystep::real::Precision;
 use raystep::render::Settings;
 use raystep::scene::Scene;
@@ -308,7 +306,7 @@ fn no_panic<R>(what: &str, f: impl FnOnce() -> R) -> Result<R, String> {
 /// `settings`. Returns whether it was accepted; a failure carries the whole story.
 fn load_and_render(
     text: &str,
-    size: SizeOverride,
+    size: Overrides,
     settings: &[(&str, Settings)],
 ) -> Result<bool, TestCaseError> {
     let fail = |what: String| {
@@ -638,27 +636,35 @@ fn mutate(text: &str, mutation: &Mutation) -> String {
     }
 }
 
-/// A size to parse at: both sides overridden, the width only, or the file's own.
-fn any_size() -> impl Strategy<Value = SizeOverride> {
+/// A size to parse at: both sides overridden, the width only, the file's own, or
+/// the file's own with `--max-depth`.
+fn any_size() -> impl Strategy<Value = Overrides> {
     prop_oneof![
-        6 => (1..=20u32, 1..=12u32).prop_map(|(w, h)| SizeOverride {
+        6 => (1..=20u32, 1..=12u32).prop_map(|(w, h)| Overrides {
             width: Some(w),
             height: Some(h),
+            max_depth: None,
         }),
-        1 => (1..=20u32).prop_map(|w| SizeOverride {
+        1 => (1..=20u32).prop_map(|w| Overrides {
             width: Some(w),
             height: None,
+            max_depth: None,
         }),
-        2 => Just(SizeOverride::default()),
+        2 => Just(Overrides::default()),
+        1 => (1..=64u32).prop_map(|d| Overrides {
+            max_depth: Some(d),
+            ..Overrides::default()
+        }),
     ]
 }
 
 #[test]
 fn a_mutated_scene_file_is_refused_with_a_message_or_renders_sound_pixels() {
     // Every seed is valid and renders soundly before it is mutated.
-    let small = SizeOverride {
+    let small = Overrides {
         width: Some(12),
         height: Some(8),
+        max_depth: None,
     };
     for (name, text) in SEEDS.iter() {
         let scene = parse_sized(text, name, small).unwrap_or_else(|e| panic!("{e}"));
@@ -949,9 +955,10 @@ fn random_scenes_at_extreme_scales_render_sound_pixels() {
     let tally = Tally::default();
     let strategy = (random_scene(), 1..=20u32, 1..=12u32, any_settings());
     let result = runner(cases(200)).run(&strategy, |(scene, width, height, random)| {
-        let size = SizeOverride {
+        let size = Overrides {
             width: Some(width),
             height: Some(height),
+            max_depth: None,
         };
         tally.count(load_and_render(
             &scene.toml(),
@@ -985,9 +992,10 @@ fn the_faults_fuzzing_found_stay_fixed() {
         format!("[camera]\nposition = [0, 0, 1]\n[light]\nposition = [5, 5, 5]\n{rest}")
     };
     // Odd: the middle row's rays are exactly level with the plane of A.
-    let size = SizeOverride {
+    let size = Overrides {
         width: Some(15),
         height: Some(15),
+        max_depth: None,
     };
     let offset_0 = Settings {
         offset: Offset::Fixed(0.0),
@@ -1021,9 +1029,10 @@ fn the_faults_fuzzing_found_stay_fixed() {
     let flat_screen = "[camera]\nposition = [0, 0, 1]\n[screen]\nleft = -0.0003\nright = 0.0003\n\
                        top = 1e-300\nbottom = 0\n[light]\nposition = [2000, 2000, -3000]\n\
                        [[sphere]]\ncenter = [0, 0, -5000]\nradius = 1\n";
-    let two = SizeOverride {
+    let two = Overrides {
         width: Some(2),
         height: Some(2),
+        max_depth: None,
     };
     assert_eq!(
         load_and_render(flat_screen, two, &all).map_err(|e| e.to_string()),

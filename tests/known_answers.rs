@@ -627,9 +627,10 @@ fn the_tree_of_a_large_scene_changes_no_pixel() {
 fn a_partial_screen_follows_the_size_flags() {
     let text =
         "[camera]\nposition = [0, 0, 1]\n[light]\nposition = [5, 5, 5]\n[screen]\nleft = -1\n";
-    let size = raystep::io::scene_file::SizeOverride {
+    let size = raystep::io::scene_file::Overrides {
         width: Some(100),
         height: Some(100),
+        max_depth: None,
     };
     let scene = raystep::io::scene_file::parse_sized(text, "t", size).unwrap();
     let screen = scene.screen.unwrap();

@@ -316,16 +316,17 @@ fn register_font() {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::scene_file::{parse_sized, SizeOverride, SEED_NAME, SEED_TOML};
+    use crate::io::scene_file::{parse_sized, Overrides, SEED_NAME, SEED_TOML};
     use crate::render::{render, Settings};
     use crate::stages::{Stage, Stages};
 
     /// The seed scene at `width × height`, every stage, into a sheet of thumbnails
     /// at most `max_width` wide; and the frame of the last stage.
     fn sheet(width: u32, height: u32, max_width: u32) -> (ContactSheet, Frame) {
-        let size = SizeOverride {
+        let size = Overrides {
             width: Some(width),
             height: Some(height),
+            max_depth: None,
         };
         let scene = parse_sized(SEED_TOML, SEED_NAME, size).unwrap();
         let mut sheet = ContactSheet::new(max_width);

@@ -69,13 +69,18 @@ pub const MAX_DEPTH: u32 = 64;
 /// Largest scene file read, in bytes.
 pub const MAX_FILE_BYTES: u64 = 16 * 1024 * 1024;
 
-/// An image size from the command line, overriding the scene's `[image]`.
+/// What the command line says in place of the file: `--width` and `--height`
+/// for `[image]`, `--max-depth` for `render.max_depth`. A key overridden is not
+/// checked against its range in the file (its type still is), so a file may be
+/// rendered smaller, or shallower, than it asks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct SizeOverride {
+pub struct Overrides {
     /// `--width`.
     pub width: Option<u32>,
     /// `--height`.
     pub height: Option<u32>,
+    /// `--max-depth`.
+    pub max_depth: Option<u32>,
 }
 
 /// The built-in figure-1 scene.
@@ -85,7 +90,7 @@ pub fn seed() -> Scene {
 
 /// Read and check the scene file at `path`.
 pub fn load(path: &Path) -> Result<Scene, Error> {
-    load_sized(path, SizeOverride::default())
+    load_sized(path, Overrides::default())
 }
 
 /// The name of the scene read from standard input (the path `-`) in messages.
@@ -107,7 +112,7 @@ pub fn display_name(path: &Path) -> String {
 
 /// Read and check the scene file at `path` (`-`: standard input), at the size
 /// `size` asks for.
-pub fn load_sized(path: &Path, size: SizeOverride) -> Result<Scene, Error> {
+pub fn load_sized(path: &Path, size: Overrides) -> Result<Scene, Error> {
     let file = display_name(path);
     let fail = |message: String| Error::Scene {
         file: file.clone(),
@@ -176,24 +181,24 @@ pub fn load_sized(path: &Path, size: SizeOverride) -> Result<Scene, Error> {
 
 /// Check the TOML text of a scene; `file` names it in error messages.
 pub fn parse(text: &str, file: &str) -> Result<Scene, Error> {
-    parse_sized(text, file, SizeOverride::default())
+    parse_sized(text, file, Overrides::default())
 }
 
 /// Check the TOML text of a scene at the size `size` asks for (the size decides the
 /// default screen, so it is settled before anything is checked).
-pub fn parse_sized(text: &str, file: &str, size: SizeOverride) -> Result<Scene, Error> {
+pub fn parse_sized(text: &str, file: &str, size: Overrides) -> Result<Scene, Error> {
     parse_text(text, file, size, true)
 }
 
 /// [`parse_sized`] for a text made from the file, not the file's own (the studio's
 /// moved light or camera): a value out of range is named by table and key alone,
 /// since a line and column of that text would point at nothing in the file.
-pub fn parse_edited(text: &str, file: &str, size: SizeOverride) -> Result<Scene, Error> {
+pub fn parse_edited(text: &str, file: &str, size: Overrides) -> Result<Scene, Error> {
     parse_text(text, file, size, false)
 }
 
 /// [`parse_sized`], and whether a value out of range gets its place ([`located`]).
-fn parse_text(text: &str, file: &str, size: SizeOverride, locate: bool) -> Result<Scene, Error> {
+fn parse_text(text: &str, file: &str, size: Overrides, locate: bool) -> Result<Scene, Error> {
     let fail = |message: String| Error::Scene {
         file: file.to_string(),
         message,
@@ -222,7 +227,7 @@ fn parse_text(text: &str, file: &str, size: SizeOverride, locate: bool) -> Resul
         Some(raw) => raw,
         None => toml::from_str::<SceneFile>(text).map_err(|e| fail(toml_error(&e, text)))?,
     };
-    let overridden = size.width.is_some() || size.height.is_some();
+    let overridden = size != Overrides::default();
     raw.check(size).map_err(|message| match () {
         _ if overridden && message.starts_with("--") => Error::Usage(message),
         _ if locate => fail(located(text, message)),
@@ -851,16 +856,16 @@ macro_rules! material_keys {
 }
 
 impl SceneFile {
-    fn check(self, size: SizeOverride) -> Result<Scene, String> {
+    fn check(self, overrides: Overrides) -> Result<Scene, String> {
         let image = self.image.unwrap_or(ImageKeys {
             width: None,
             height: None,
         });
-        let width = match size.width {
+        let width = match overrides.width {
             Some(w) => (w, "--width"),
             None => (image.width.unwrap_or(300), "image.width"),
         };
-        let height = match size.height {
+        let height = match overrides.height {
             Some(h) => (h, "--height"),
             None => (image.height.unwrap_or(200), "image.height"),
         };
@@ -906,8 +911,14 @@ impl SceneFile {
             specular: colour(self.light.specular, Vec3::ONE, &"light.specular")?,
         };
 
-        let max_depth = self.render.and_then(|r| r.max_depth).unwrap_or(3);
-        check_max_depth(max_depth, "render.max_depth")?;
+        let (max_depth, source) = match overrides.max_depth {
+            Some(depth) => (depth, "--max-depth"),
+            None => (
+                self.render.and_then(|r| r.max_depth).unwrap_or(3),
+                "render.max_depth",
+            ),
+        };
+        check_max_depth(max_depth, source)?;
 
         let mut objects = Vec::new();
         for (i, keys) in self.sphere.into_iter().enumerate() {
@@ -1473,7 +1484,7 @@ mod tests {
     /// What the file gives read whole: its scene, or the message refusing it.
     fn whole(text: &str) -> Result<Scene, String> {
         let raw = toml::from_str::<SceneFile>(text).map_err(|e| toml_error(&e, text))?;
-        raw.check(SizeOverride::default())
+        raw.check(Overrides::default())
     }
 
     const HEAD: &str = "[image]\nwidth = 64\nheight = 48\n\n[camera]\nposition = [0, 0, 1]\n\n\
@@ -1525,7 +1536,7 @@ mod tests {
         for part in [1, 2, 7, 59, 60, 1000] {
             let raw = read_apart(&text, part).expect("a file of spheres is read in parts");
             assert_eq!(
-                raw.check(SizeOverride::default()).as_ref(),
+                raw.check(Overrides::default()).as_ref(),
                 Ok(&expected),
                 "{part}"
             );
@@ -1639,7 +1650,7 @@ mod tests {
             let text = lines.concat();
             if let Some(raw) = read_apart(&text, part) {
                 // The same scene, or the same message from checking it.
-                proptest::prop_assert_eq!(raw.check(SizeOverride::default()), whole(&text), "{}", text);
+                proptest::prop_assert_eq!(raw.check(Overrides::default()), whole(&text), "{}", text);
             }
         }
     }
@@ -1823,6 +1834,42 @@ mod tests {
             small("[render]\nmax_depth = 65\n"),
             Err("render.max_depth = 65: must be from 1 to 64".into())
         );
+    }
+
+    #[test]
+    fn an_overridden_key_is_not_range_checked_in_the_file_but_still_typed() {
+        let check = |extra: &str, overrides: Overrides| {
+            let raw: SceneFile = toml::from_str(&format!("{SMALL}{extra}")).unwrap();
+            raw.check(overrides)
+        };
+        let depth = Overrides {
+            max_depth: Some(2),
+            ..Overrides::default()
+        };
+        let deep = check("[render]\nmax_depth = 100\n", depth).unwrap();
+        assert_eq!(deep.max_depth, 2);
+        let wide = Overrides {
+            width: Some(30),
+            ..Overrides::default()
+        };
+        let scene = check("[image]\nwidth = 20000\nheight = 20\n", wide).unwrap();
+        assert_eq!((scene.width, scene.height), (30, 20));
+        // What is not overridden is checked as before.
+        assert_eq!(
+            check("[render]\nmax_depth = 100\n", wide),
+            Err("render.max_depth = 100: must be from 1 to 64".into())
+        );
+        // The type is the file's to get right, overridden or not.
+        assert!(
+            toml::from_str::<SceneFile>(&format!("{SMALL}[render]\nmax_depth = \"deep\"\n"))
+                .is_err()
+        );
+        assert!(parse_sized(
+            &format!("{SMALL}[render]\nmax_depth = \"deep\"\n"),
+            "t",
+            depth
+        )
+        .is_err());
     }
 
     #[test]

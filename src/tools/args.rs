@@ -10,7 +10,7 @@ use clap::{Args, Parser, Subcommand};
 use crate::accel::Accel;
 use crate::error::{to_stderr, Error};
 use crate::io::output::{ExrCompression, PngEncoding};
-use crate::io::scene_file::{self, check_max_depth, SizeOverride};
+use crate::io::scene_file::{self, check_max_depth, Overrides};
 use crate::real::Precision;
 use crate::render::Settings;
 use crate::scene::Scene;
@@ -547,7 +547,7 @@ impl RuleArgs {
             ));
         }
         let method = self.intersect.unwrap_or(base.method);
-        if self.accel == Some(Accel::Bvh) && method == Method::Naive {
+        if self.accel == Some(Accel::Bvh) && !Accel::Bvh.builds_bvh(0, method) {
             to_stderr(format_args!(
                 "warning: --accel bvh: the textbook quadratic (--intersect naive{}) gets no \
                  BVH, since its false hits far outside a sphere (chapter 9) would fall \
@@ -573,7 +573,7 @@ impl RuleArgs {
 /// The scene and settings a `render` (or `bench`) command line asks for.
 pub fn prepare(args: &FrameArgs) -> Result<(Scene, Settings), Error> {
     let stages = Stages::select(args.stage, &args.without).map_err(Error::Usage)?;
-    let (mut scene, name) = load_scene(&args.scene)?;
+    let (mut scene, name) = load_scene(&args.scene, args.rules.max_depth)?;
     let settings = args.rules.apply(&mut scene, &name, stages)?;
     Ok((scene, settings))
 }
@@ -596,11 +596,14 @@ pub fn scene_name(args: &SceneArgs) -> String {
     }
 }
 
-/// Load the scene named by `args` (or the built-in one) and apply the size flags.
-pub fn load_scene(args: &SceneArgs) -> Result<(Scene, String), Error> {
-    let size = SizeOverride {
+/// Load the scene named by `args` (or the built-in one) and apply the size flags
+/// and `max_depth` (`--max-depth`, which then replaces the file's
+/// `render.max_depth` unchecked, as `--width` replaces `image.width`).
+pub fn load_scene(args: &SceneArgs, max_depth: Option<u32>) -> Result<(Scene, String), Error> {
+    let size = Overrides {
         width: args.width,
         height: args.height,
+        max_depth,
     };
     let scene = match &args.scene {
         Some(path) => scene_file::load_sized(path, size)?,

@@ -18,7 +18,6 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::accel::{Accel, BVH_FROM};
 use crate::aov::{Frame, Packets, Rays};
 use crate::bvh::Bvh;
 use crate::engine::render_into;
@@ -26,7 +25,6 @@ use crate::error::Error;
 use crate::real::Precision;
 use crate::render::{Progress, Settings};
 use crate::scene::{Role, Scene};
-use crate::sphere::Method;
 use crate::stages::Engine;
 use crate::tools::yardstick::Yardstick;
 
@@ -293,19 +291,14 @@ pub fn bench(
 }
 
 /// Does a render of `scene` under `settings` build a BVH? (As `Tracer::new`
-/// decides.)
+/// decides, by [`Accel::builds_bvh`].)
 fn uses_bvh(scene: &Scene, settings: &Settings) -> bool {
     let spheres = scene
         .objects
         .iter()
         .filter(|o| o.role == Role::Sphere)
         .count();
-    match settings.accel {
-        _ if settings.method == Method::Naive => false,
-        Accel::Off => false,
-        Accel::Auto => spheres >= BVH_FROM,
-        Accel::Bvh => true,
-    }
+    settings.accel.builds_bvh(spheres, settings.method)
 }
 
 /// The median of some times (the mean of the middle two for an even count).

@@ -354,7 +354,7 @@ pub fn scale(
                 }
                 progress(1);
             }
-            let uses_bvh = accel == Accel::Auto && count >= crate::accel::BVH_FROM;
+            let uses_bvh = accel.builds_bvh(count, settings.method);
             points.push(ScalePoint {
                 count,
                 series: Series::Raystep(accel),

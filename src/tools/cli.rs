@@ -249,7 +249,7 @@ pub const CONTACT_SHEET: &str = "contact-sheet.png";
 
 fn stages(args: StagesArgs) -> Result<(), Error> {
     args.refuse_render_flags()?;
-    let (mut scene, name) = load_scene(&args.scene)?;
+    let (mut scene, name) = load_scene(&args.scene, args.rules.max_depth)?;
     let base = args.rules.apply(&mut scene, &name, Stages::ALL)?;
     // Every file of every stage is renamed into place at the end, together: an
     // error or Ctrl-C on the way leaves the folder as it was.
@@ -537,7 +537,7 @@ fn chart(mut args: ChartArgs) -> Result<(), Error> {
         return Ok(());
     }
     args.scene.default_size(960, 540);
-    let (scene, name) = load_scene(&args.scene)?;
+    let (scene, name) = load_scene(&args.scene, None)?;
     status!(
         "{name}: speed against accuracy at {} × {}",
         scene.width,

@@ -21,7 +21,7 @@ use serde_json::{json, Value};
 use crate::aov::{Buffer, Frame};
 use crate::error::Error;
 use crate::io::output::PngEncoding;
-use crate::io::scene_file::{self, SizeOverride};
+use crate::io::scene_file::{self, Overrides};
 use crate::render::Settings;
 use crate::scene::Scene;
 use crate::stages::Stages;
@@ -180,7 +180,7 @@ struct Served {
     settling: Option<Option<Stamp>>,
     bytes: Option<Vec<u8>>,
     /// Scenes parsed at other sizes, for this version: (size, scene).
-    sized: Vec<(SizeOverride, Arc<Scene>)>,
+    sized: Vec<(Overrides, Arc<Scene>)>,
     /// The server is stopping: waiters leave.
     stopping: bool,
 }
@@ -366,10 +366,10 @@ impl Studio {
         self.changed.notify_all();
     }
 
-    /// The last good scene at the size `size` asks for, as the command line
+    /// The last good scene at the size (and depth) `size` asks for, as the command line
     /// would load it (the size decides the default screen, so the text is parsed
     /// again at each size), and the version it belongs to.
-    fn scene_at(&self, size: SizeOverride, edits: &Edits) -> Result<(Scene, u64), Error> {
+    fn scene_at(&self, size: Overrides, edits: &Edits) -> Result<(Scene, u64), Error> {
         if !edits.is_empty() {
             let (text, version) = {
                 let served = self.lock();
@@ -380,7 +380,7 @@ impl Studio {
         }
         let (text, version) = {
             let served = self.lock();
-            if size == SizeOverride::default() {
+            if size == Overrides::default() {
                 return Ok((Scene::clone(&served.scene), served.version));
             }
             if let Some((_, scene)) = served.sized.iter().find(|(s, _)| *s == size) {
@@ -404,9 +404,10 @@ impl Studio {
     /// the one the command line reports.
     fn prepare(&self, frame: &FrameArgs, edits: &Edits) -> Result<(Scene, Settings, u64), Error> {
         let stages = Stages::select(frame.stage, &frame.without).map_err(Error::Usage)?;
-        let size = SizeOverride {
+        let size = Overrides {
             width: frame.scene.width,
             height: frame.scene.height,
+            max_depth: frame.rules.max_depth,
         };
         let (mut scene, version) = self.scene_at(size, edits)?;
         let settings = frame.rules.apply(&mut scene, &self.name, stages)?;
