@@ -38,8 +38,9 @@ pub enum Accel {
 
 impl Accel {
     /// Whether a tracer under this choice builds a BVH over `spheres` spheres
-    /// met by `method`. The one place that decides it: the book's tracer, `bench`
-    /// (which times the build) and `--accel bvh`'s warning all ask here. The
+    /// met by `method`. The one place that decides it: the book's tracer (and so
+    /// the fast engine, built on it), `bench` (which times the build), `chart
+    /// --scale` and `--accel bvh`'s warning all ask here. The
     /// textbook quadratic gets none: its false hits far outside a sphere (chapter
     /// 9) would fall outside the boxes and change the picture.
     pub fn builds_bvh(self, spheres: usize, method: Method) -> bool {

@@ -14,8 +14,10 @@
 //! ──► colour clipped to [0, 1] and the first-hit record ──► buffers (aov) ──► PNG + EXR (output)
 //! ```
 //!
-//! The modules below are listed in the order the book introduces them, so this
-//! file reads as its table of contents.
+//! The modules below are grouped by the chapter that introduces them, each group
+//! naming its chapter, so this file reads as a rough table of contents (the
+//! pixel loop, `render`, and the buffers, `aov`, appear from chapters 2 and 3 on,
+//! and are listed after the stages they run).
 // One place only, with its reason: the packet loop's AVX build, declared
 // `unsafe` for its target feature, and its call once the processor is found to
 // have AVX (`Fast::packet_row`, fast/mod.rs).

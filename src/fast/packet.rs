@@ -410,7 +410,7 @@ impl<T: Laned> Traced4<T> {
     fn write(&self, mean: Option<[Vec3; WIDTH]>, rays: &[Rays; WIDTH], out: &mut [PixelRecord]) {
         let zero = T::Lanes::splat(T::of(0.0));
         let one = T::Lanes::splat(T::of(1.0));
-        // Real::clamp01 lane by lane (a NaN stays), then float32.
+        // Vector::clamp01 lane by lane (a NaN stays), then float32.
         let clamp = |c: T::Lanes| c.lt(zero).select(zero, c.gt(one).select(one, c));
         let f32s = |l: T::Lanes| {
             let a = l.to_array();
@@ -916,12 +916,20 @@ impl<T: Laned> Fast<T> {
     /// Distance along each ray to `object`, and the mask of the lanes that hit it,
     /// by the rules of [`Object::intersect`].
     ///
-    /// The one formula of the book written a second time here (the others the
-    /// packet computes with the book's own generic functions): where one ray
-    /// branches on Δ and on the signs of its roots, four rays need masks, and the
-    /// early outs that skip the square root and the division when all four miss
-    /// are most of the packets' gain on shadow and reflected rays (chapter 10).
-    /// `tests/speed.rs` holds the two to the same bits.
+    /// The book's intersection tests (the sphere's, by both methods, and the
+    /// plane's) written a second time: where one ray branches on Δ and on the
+    /// signs of its roots, four rays need masks, and the early outs that skip the
+    /// square root and the division when all four miss are most of the packets'
+    /// gain on shadow and reflected rays (chapter 10). They are not the only
+    /// second copy: the plane's normal ([`Fast::normal_packet`]), the sum of the
+    /// Blinn-Phong terms ([`Fast::terms_packet`]) and the path loop
+    /// ([`Fast::trace_packet`]) are written again too, and only the branch-free
+    /// formulas (the factors of Blinn-Phong, the offsets) are the book's own
+    /// generic functions. So an edit to the book's `Sphere::intersect`,
+    /// `Plane::normal_towards`, `blinn_phong::terms` or `Tracer::trace` does not
+    /// reach this engine: `tests/speed.rs` holds the two to the same bits, and
+    /// fails until the edit is made here too. (`render` and `stages` use the
+    /// book's engine unless asked, so their pictures show such an edit at once.)
     #[inline(always)]
     fn hits(&self, object: &Shape4<T>, ray: &Packet<T>) -> (T::Lanes, T::Lanes) {
         let zero = T::Lanes::splat(T::of(0.0));

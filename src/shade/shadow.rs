@@ -10,8 +10,10 @@ use crate::sphere::Method;
 pub const TUTORIAL_STEP: f64 = 1e-5;
 
 /// The `scene` offset (raystep's `auto` before the bound below) steps out by this
-/// many unit roundoffs of the size of the numbers the surface is computed from,
-/// the largest coordinate of its centre (or anchor) plus its radius. Kept to be
+/// many unit roundoffs of the size of the numbers the point is computed from: the
+/// larger of the surface's size (the largest coordinate of its centre or anchor,
+/// plus its radius) and the point's own largest coordinate (so that a floor
+/// through the origin still steps out far from it). Kept to be
 /// measured against (`--offset scene`): it is right at every scale, but for a
 /// sphere far from the origin compared with its radius it is a sizeable part of
 /// the radius (8·u·(max|Cᵢ| + r), with max|Cᵢ| the centre's largest coordinate,
@@ -45,8 +47,8 @@ pub enum Offset {
     /// A fixed distance, whatever the scene's scale: `fixed:1e-5` is the tutorial's.
     Fixed(f64),
     /// Put the point back on the surface, then step out by [`SCENE_FACTOR`] unit
-    /// roundoffs of the size of the surface's numbers (raystep's first automatic
-    /// offset, kept for comparison).
+    /// roundoffs of the larger of the surface's size and the point's largest
+    /// coordinate (raystep's first automatic offset, kept for comparison).
     Scene,
     /// Move the point to a height above the surface that is a bound of the
     /// error of that move and of the next ray's test ([`sphere_step`],

@@ -36,7 +36,9 @@ pub struct Cli {
 }
 
 /// The limits that keep a mistake from taking the machine down, as `--help` prints
-/// them (the numbers are the constants of [`scene_file`]).
+/// them (the numbers are the constants of [`scene_file`], `samples`,
+/// `tools::generate`, `io::generated` and `tools::cli`; a test in
+/// `tests/hostile.rs` checks each).
 pub const LIMITS: &str = "\
 Limits (a value beyond them is refused with a message, exit code 2):
   image          1 to 16384 pixels a side, at most 7680 × 4320 in all: a render

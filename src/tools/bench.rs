@@ -1,6 +1,6 @@
 //! `raystep bench`: how fast a frame renders, against a yardstick, in one run.
 //!
-//! Four things are timed (five where the render builds a BVH: its build alone
+//! Up to four things are timed (five where the render builds a BVH: its build alone
 //! too), their runs interleaved so that a noisy machine slows all of them alike:
 //! the engine asked for (`--engine`, default `fast`) with the threads asked for
 //! and with one thread, the other engine with the threads asked for, and the

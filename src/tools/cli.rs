@@ -109,7 +109,7 @@ pub fn execute(cli: Cli) -> Result<u8, Error> {
     // The commands that render start their threads first, so that a machine that
     // cannot give them (RAYON_NUM_THREADS=200 under a memory limit) gets a message
     // instead of a panic inside rayon. bench builds its own pools, with the same
-    // care; check, diff and generate need none.
+    // care; check, diff, generate, completions and man need none.
     if !matches!(
         cli.command,
         Some(
