@@ -1299,6 +1299,8 @@ fn a_scene_on_stdin_and_output_aliases() {
     let check = raystep_with_input(dir.path(), &["check", "-"], &seed);
     assert!(check.status.success(), "{}", text(&check.stderr));
     assert!(text(&check.stdout).starts_with("<stdin>: a valid scene"));
+    // A pipe is not a terminal: no notice (a_scene_typed_at_a_terminal_... has it).
+    assert_eq!(text(&check.stderr), "");
     let broken = raystep_with_input(dir.path(), &["check", "-"], b"[camera]\nposition = 3\n");
     assert_eq!(broken.status.code(), Some(2));
     assert!(
@@ -1326,6 +1328,48 @@ fn a_scene_on_stdin_and_output_aliases() {
         "{}",
         text(&serve.stderr)
     );
+}
+
+/// Where `script` (util-linux) runs a command at a terminal of its own.
+fn terminal_runner() -> Result<(), String> {
+    match Command::new("script").arg("--version").output() {
+        Ok(out) if out.status.success() => Ok(()),
+        _ => Err("script, which gives a command a terminal (apt-get install bsdutils)".into()),
+    }
+}
+
+#[test]
+fn a_scene_typed_at_a_terminal_is_announced_before_it_is_read() {
+    use std::io::Write;
+    use std::process::Stdio;
+    if common::required(terminal_runner(), "the terminal test").is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let seed = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/seed.toml")).unwrap();
+    let command = format!("'{}' check -", env!("CARGO_BIN_EXE_raystep"));
+    let mut child = Command::new("script")
+        .args(["-qec", &command, "/dev/null"])
+        .current_dir(dir.path())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The scene, then Ctrl-D at the start of a line: the end of what is typed.
+    let mut typed = seed.clone();
+    typed.push(4);
+    child.stdin.take().unwrap().write_all(&typed).unwrap();
+    let out = child.wait_with_output().unwrap();
+    let said = text(&out.stdout);
+    assert!(out.status.success(), "{said}{}", text(&out.stderr));
+    let notice = said
+        .find("reading the scene from standard input (end it with Ctrl-D)")
+        .unwrap_or_else(|| panic!("no notice in:\n{said}"));
+    let report = said
+        .find("<stdin>: a valid scene")
+        .unwrap_or_else(|| panic!("{said}"));
+    assert!(notice < report, "{said}");
 }
 
 #[test]
