@@ -29,19 +29,24 @@ pub fn render_into(scene: &Scene, settings: &Settings, frame: &mut Frame, progre
 /// [`render`], unless `cancel` is set before it ends: then no new row is
 /// started and the answer is `None` (the unfinished frame is thrown away).
 /// `raystep serve` sets it when a newer request supersedes the render.
+/// `row_done` is told of each row finished (from any thread), as a
+/// [`Progress`] is.
 pub fn render_cancellable(
     scene: &Scene,
     settings: &Settings,
     cancel: &AtomicBool,
+    row_done: &(dyn Fn() + Sync),
 ) -> Option<Frame> {
-    /// Rows go unreported; the flag is asked before each one.
-    struct Unless<'a>(&'a AtomicBool);
+    /// Rows are told to the caller; the flag is asked before each one.
+    struct Unless<'a>(&'a AtomicBool, &'a (dyn Fn() + Sync));
     impl Progress for Unless<'_> {
-        fn row_done(&self) {}
+        fn row_done(&self) {
+            (self.1)()
+        }
         fn cancelled(&self) -> bool {
             self.0.load(Ordering::Relaxed)
         }
     }
-    let frame = render(scene, settings, &Unless(cancel));
+    let frame = render(scene, settings, &Unless(cancel, row_done));
     (!cancel.load(Ordering::SeqCst)).then_some(frame)
 }

@@ -148,6 +148,7 @@ fn float64_renders_the_seed_moved_1e5_away_as_it_renders_the_seed() {
         frame.pixels.iter().map(|p| p.shadow).collect::<Vec<f32>>()
     };
     let (one, far) = (masks("seed-x1"), masks("seed-moved-1e5"));
+    assert!(!one.is_empty() && one.len() == far.len());
     let differ = one.iter().zip(&far).filter(|(a, b)| a != b).count();
     // Measured: the pixels whose rays pass within a few 1e-11 of a silhouette.
     assert!(differ <= 5, "{differ} of {} pixels differ", one.len());
@@ -300,7 +301,10 @@ fn the_same_shadow_mask_at_every_scale_with_the_defaults() {
         let frame = render(&case(name).unwrap(), &settings, &|_| {});
         frame.pixels.iter().map(|p| p.shadow).collect::<Vec<f32>>()
     };
-    let differ = |a: &[f32], b: &[f32]| a.iter().zip(b).filter(|(x, y)| x != y).count();
+    let differ = |a: &[f32], b: &[f32]| {
+        assert_eq!(a.len(), b.len());
+        a.iter().zip(b).filter(|(x, y)| x != y).count()
+    };
     let one = mask("seed-x1", AUTO);
     // Every scaled copy of figure 1 the stress cases hold, ×1e-4 to ×1e4.
     let mut scales = 0;

@@ -1110,10 +1110,13 @@ fn figures_writes_the_committed_names_and_check_reports_each_kind_of_problem() {
 }
 
 /// A figure is encoded as its command's `--png` says: sRGB for the one command
-/// that asks for it, linear for every other.
+/// that asks for it, linear for every other; and the files `raystep figures`
+/// writes are so (an `sRGB` chunk in each colour picture of that figure, in no
+/// other file).
 #[test]
 fn each_figure_is_encoded_as_its_command_says() {
     use raystep::io::output::PngEncoding;
+    use raystep::tools::figures::write_all;
     for figure in FIGURES {
         let expected = if figure.args.contains("--png srgb") {
             PngEncoding::Srgb
@@ -1123,4 +1126,20 @@ fn each_figure_is_encoded_as_its_command_says() {
         assert_eq!(figure.png(), expected, "{}", figure.name);
     }
     assert!(FIGURES.iter().any(|f| f.png() == PngEncoding::Srgb));
+    let small =
+        |args: &str, root: &Path| render_command(&format!("{args} --width 8 --height 6"), root);
+    let dir = tempfile::tempdir().unwrap();
+    write_all(&root(), dir.path(), &small).unwrap();
+    let mut srgb = 0;
+    for figure in FIGURES {
+        for &buffer in figure.buffers {
+            let file = format!("{}-{}.png", figure.name, buffer.name());
+            let bytes = std::fs::read(dir.path().join(&file)).unwrap();
+            let tagged = common::png_chunks(&bytes).iter().any(|c| c == "sRGB");
+            let asked = figure.args.contains("--png srgb") && PngEncoding::applies_to(buffer);
+            assert_eq!(tagged, asked, "{file}");
+            srgb += usize::from(tagged);
+        }
+    }
+    assert!(srgb > 0, "no figure file is sRGB");
 }

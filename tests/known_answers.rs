@@ -617,6 +617,7 @@ fn the_tree_of_a_large_scene_changes_no_pixel() {
         for engine in [Engine::Book, Engine::Fast] {
             let tree = raystep::engine::render(&scene, &with(Accel::Bvh, engine), &|_| {});
             assert_eq!(tree.engine, engine);
+            assert_eq!(tree.pixels.len(), off.pixels.len());
             let apart = off.pixels.iter().zip(&tree.pixels).filter(|(a, b)| a != b);
             assert_eq!(apart.count(), 0, "{precision:?}, {engine:?}");
         }

@@ -32,6 +32,7 @@ fn reproduces_figure_1(engine: Engine) {
     };
     let frame = raystep::engine::render(&common::seed(300, 200), &settings, &|_| {});
     assert_eq!(frame.engine, engine);
+    assert_eq!(frame.pixels.len(), reference.len());
     let mut worst = (0.0f32, 0usize);
     for (i, (ours, theirs)) in frame.pixels.iter().zip(&reference).enumerate() {
         for (a, b) in ours.colour.iter().zip(theirs) {

@@ -111,14 +111,45 @@ fn every_object_a_primary_ray_hits_is_in_its_tiles_mask() {
     // reports hits far outside a small, far sphere's outline (tiny-far,
     // far-sphere), and the mask's margin must hold them too. Checked against the
     // book engine's own first hits, without the masks, in both precisions and
-    // methods, with samples jittered to the pixel's edges. (The margin's 256 unit
-    // roundoffs of the squared distance are room to spare: one already holds the
-    // false hits here. What this holds is that the margin is there at all.)
+    // methods; and with four samples a pixel, jittered to the pixel's edges, the
+    // first hit of each sample, traced here (a record holds its centre ray's).
+    // (The margin's 256 unit roundoffs of the squared distance are room to spare:
+    // one already holds the false hits here. What this holds is that the margin
+    // is there at all.)
     use raystep::fast::masks::TileMasks;
     use raystep::render::Tracer;
     fn masks_of<T: raystep::real::Real>(scene: &Scene, settings: &Settings) -> TileMasks {
         let tracer = Tracer::<T>::new(scene, settings);
         TileMasks::new(&tracer.camera, &tracer.objects)
+    }
+    /// The first sample ray (of `settings.spp` a pixel, jittered as the render
+    /// jitters them) whose first hit is outside its tile's mask, and how many
+    /// samples hit something. (A record's `object` is its pixel's centre ray's,
+    /// so the samples are traced here.)
+    fn sample_outside_mask<T: raystep::real::Real>(
+        scene: &Scene,
+        settings: &Settings,
+    ) -> (Option<String>, usize) {
+        let tracer = Tracer::<T>::new(scene, settings);
+        let masks = TileMasks::new(&tracer.camera, &tracer.objects);
+        let mut hits = 0;
+        for row in 0..scene.height {
+            for col in 0..scene.width {
+                for sample in 0..settings.spp {
+                    let (y, x) = raystep::samples::stratified(row, col, sample, settings.spp);
+                    let ray = tracer.camera.ray_through::<T>(y, x);
+                    let Some(hit) = tracer.nearest_hit(&ray) else {
+                        continue;
+                    };
+                    hits += 1;
+                    if masks.mask(row, col) & (1 << hit.object) == 0 {
+                        let at = format!("pixel (row {row}, col {col}), sample {sample}");
+                        return (Some(format!("{at} hits object {}", hit.object)), hits);
+                    }
+                }
+            }
+        }
+        (None, hits)
     }
     // tiny-far's sphere fills its picture; on a screen 30 times as wide and high
     // it is a dot of a few pixels, and float32's false hits fall on every tile.
@@ -133,6 +164,7 @@ fn every_object_a_primary_ray_hits_is_in_its_tiles_mask() {
     // Pixels of it that float32's textbook quadratic hits and float64's stable
     // test misses: false hits, outside the outline.
     let mut outside_outline = 0;
+    let mut sample_hits = 0;
     for (name, scene) in list {
         let mut exact_misses = Vec::new();
         for precision in [Precision::F64, Precision::F32] {
@@ -149,6 +181,16 @@ fn every_object_a_primary_ray_hits_is_in_its_tiles_mask() {
                         Precision::F64 => masks_of::<f64>(&scene, &settings),
                         Precision::F32 => masks_of::<f32>(&scene, &settings),
                     };
+                    if spp > 1 {
+                        let (outside, hits) = match precision {
+                            Precision::F64 => sample_outside_mask::<f64>(&scene, &settings),
+                            Precision::F32 => sample_outside_mask::<f32>(&scene, &settings),
+                        };
+                        if let Some(outside) = outside {
+                            panic!("{name}, {precision:?}, {method:?}, spp {spp}: {outside} outside its tile's mask");
+                        }
+                        sample_hits += hits;
+                    }
                     let frame = render(&scene, &settings, &|_| {});
                     for (i, p) in frame.pixels.iter().enumerate() {
                         if p.object == raystep::aov::NO_OBJECT {
@@ -183,6 +225,7 @@ fn every_object_a_primary_ray_hits_is_in_its_tiles_mask() {
         outside_outline > 96 * 64 / 4,
         "{outside_outline} false hits in {wide_name}"
     );
+    assert!(sample_hits > 10_000, "{sample_hits} samples hit something");
 }
 
 /// Every bit of every record ([`common::record_bits`]).

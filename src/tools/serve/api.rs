@@ -599,7 +599,7 @@ impl RenderJob {
 
     /// The frame, unless `cancel` is set before it is finished.
     pub fn frame(&self, cancel: &AtomicBool) -> Option<Frame> {
-        crate::engine::render_cancellable(&self.scene, &self.settings, cancel)
+        crate::engine::render_cancellable(&self.scene, &self.settings, cancel, &|| {})
     }
 }
 
