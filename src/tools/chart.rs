@@ -980,9 +980,18 @@ mod tests {
 
     /// The renders of a sweep of two runs: the reference, then for each of the
     /// seventeen settings a warm-up and two timed runs, 1 + 17 × 3.
+    /// And a sweep of one run, of a tiny scene, renders that many frames (the
+    /// count sizes `chart`'s progress bar): 1 + 17 × 2.
     #[test]
     fn a_sweep_counts_the_reference_the_warm_ups_and_the_runs() {
         assert_eq!(sweep_renders(2), 52);
+        let mut scene = crate::io::scene_file::seed();
+        (scene.width, scene.height) = (4, 3);
+        let ticks = std::cell::Cell::new(0u64);
+        let points = sweep(&scene, 1, &|n| ticks.set(ticks.get() + n));
+        assert_eq!(ticks.get(), sweep_renders(1));
+        assert_eq!(sweep_renders(1), 35);
+        assert_eq!(points.len(), 17);
     }
 
     /// An axis over 2 to 50 reaches a factor of 1.6 beyond both ends: 1.25 to 80.
