@@ -983,6 +983,109 @@ fn chapter_12_exercise_2s_answer_applies_to_the_code_of_today() {
     );
 }
 
+/// The tests an answer's edit makes fail, as `.ci/answers` measured them
+/// (`chapters/answers/NAME.failures`, one `PROGRAM: TEST` a line).
+fn failures_of(answer: &str) -> Vec<(String, String)> {
+    let path = root().join(format!("chapters/answers/{answer}.failures"));
+    std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .lines()
+        .map(|line| {
+            let (program, test) = line.split_once(": ").unwrap_or_else(|| panic!("{line}"));
+            (program.to_string(), test.to_string())
+        })
+        .collect()
+}
+
+/// The words the answers count test programs in.
+fn in_words(n: usize) -> &'static str {
+    const WORDS: [&str; 13] = [
+        "no", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten",
+        "eleven", "twelve",
+    ];
+    WORDS[n]
+}
+
+/// Every edit of the book's code that an exercise asks for is a patch in
+/// `chapters/answers/`, with the list of the tests it makes fail beside it,
+/// which `.ci/answers` checks by applying the patch to a copy and running the
+/// tests. Here: the answers' words give that list's counts, and chapter 12's
+/// table names exactly its tests.
+#[test]
+fn the_answers_count_and_name_the_tests_their_edits_make_fail() {
+    let flat = |text: &str| text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let programs = |failures: &[(String, String)]| {
+        let mut names: Vec<&String> = failures.iter().map(|(p, _)| p).collect();
+        names.sort();
+        names.dedup();
+        names.len()
+    };
+    let answers = flat(&std::fs::read_to_string(root().join("chapters/answers.md")).unwrap());
+    for answer in ["chapter-03-far-root", "chapter-08-ambient-in-shadow"] {
+        let failures = failures_of(answer);
+        let said = format!(
+            "The tests that fail ({}, in {} test programs)",
+            failures.len(),
+            in_words(programs(&failures))
+        );
+        assert!(
+            answers.contains(&said),
+            "answers.md should say \"{said}\" ({answer})"
+        );
+    }
+    let failures = failures_of("occlusion-stage");
+    let twelve = flat(&chapter("12"));
+    let said = format!(
+        "{} tests failed, in {} test programs",
+        failures.len(),
+        programs(&failures)
+    );
+    assert!(twelve.contains(&said), "chapter 12 should say \"{said}\"");
+    // The table of the tests that fail: | `FILE` | `fn TEST`, `fn TEST` | why |.
+    // A unit test of a file under src/ runs in the crate's own test program,
+    // named by its module path.
+    let text = chapter("12");
+    let table = text
+        .split_once("| file | test | why |")
+        .expect("chapter 12's table of failing tests")
+        .1;
+    let mut named = Vec::new();
+    for row in table.lines().skip(2).take_while(|l| l.starts_with('|')) {
+        let cells: Vec<&str> = row.split(" | ").collect();
+        let file = cells[0].trim_start_matches("| ").trim_matches('`');
+        for test in cells[1].split(", ").filter_map(|t| t.strip_prefix("`fn ")) {
+            let test = test.trim_end_matches('`');
+            let program = if file.starts_with("src/") {
+                "src/lib.rs"
+            } else {
+                file
+            };
+            named.push((program.to_string(), test.to_string()));
+        }
+    }
+    let mut measured: Vec<(String, String)> = failures
+        .iter()
+        .map(|(program, test)| {
+            let name = test.rsplit("::").next().unwrap();
+            (program.clone(), name.to_string())
+        })
+        .collect();
+    named.sort();
+    measured.sort();
+    assert_eq!(
+        named, measured,
+        "chapter 12's table against occlusion-stage.failures"
+    );
+    // Every patch has its list.
+    for entry in std::fs::read_dir(root().join("chapters/answers")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "patch") {
+            let stem = path.file_stem().unwrap().to_str().unwrap();
+            assert!(!failures_of(stem).is_empty(), "{stem}");
+        }
+    }
+}
+
 #[test]
 fn no_table_row_shows_more_than_two_pictures() {
     // At the book's width of about 750 px, three pictures in a row shrink below
