@@ -811,7 +811,7 @@ fn a_bad_option_is_400_with_the_command_lines_message_and_the_server_keeps_servi
     let s = scene.to_str().unwrap();
     let out = dir.path().join("never");
     let o = out.to_str().unwrap();
-    let cases: [(&str, Vec<&str>); 8] = [
+    let cases: [(&str, Vec<&str>); 9] = [
         // clap's messages show the usage of what was given: no scene file here.
         (
             "precision=f16",
@@ -843,6 +843,10 @@ fn a_bad_option_is_400_with_the_command_lines_message_and_the_server_keeps_servi
             ],
         ),
         ("spp=3", vec!["render", s, "--spp", "3", "--out", o]),
+        (
+            "max-depth=65",
+            vec!["render", s, "--max-depth", "65", "--out", o],
+        ),
         ("pixel=1,2", vec!["render", "--pixel", "1,2", "--out", o]),
     ];
     for (query, args) in cases {

@@ -711,6 +711,17 @@ pub fn check_max_depth(max_depth: u32, source: &str) -> Result<(), String> {
     }
 }
 
+/// `--max-depth` on a scene already loaded, whose file's own `max_depth` passed
+/// then: checked and set as [`Overrides::max_depth`] is when a file is read, without
+/// reading it again (the studio asks this for the scene it serves).
+pub fn override_max_depth(scene: &mut Scene, max_depth: Option<u32>) -> Result<(), Error> {
+    if let Some(depth) = max_depth {
+        check_max_depth(depth, "--max-depth").map_err(Error::Usage)?;
+        scene.max_depth = depth;
+    }
+    Ok(())
+}
+
 pub use crate::samples::{check_spp, MAX_SPP};
 
 /// Three numbers `[x, y, z]`: exactly three, so that a fourth is an error, not

@@ -10,7 +10,7 @@ use clap::{Args, Parser, Subcommand};
 use crate::accel::Accel;
 use crate::error::{to_stderr, Error};
 use crate::io::output::{ExrCompression, PngEncoding};
-use crate::io::scene_file::{self, check_max_depth, Overrides};
+use crate::io::scene_file::{self, Overrides};
 use crate::real::Precision;
 use crate::render::Settings;
 use crate::scene::Scene;
@@ -525,13 +525,10 @@ impl StagesArgs {
 }
 
 impl RuleArgs {
-    /// The settings for `stages` under these rules; a `--max-depth` goes into
-    /// `scene`, whose messages name it `name`.
-    pub fn apply(&self, scene: &mut Scene, name: &str, stages: Stages) -> Result<Settings, Error> {
-        if let Some(depth) = self.max_depth {
-            check_max_depth(depth, "--max-depth").map_err(Error::Usage)?;
-            scene.max_depth = depth;
-        }
+    /// The settings for `stages` under these rules, for `scene`, whose messages
+    /// name it `name`. (`--max-depth` is the scene's: the loader puts it there,
+    /// [`load_scene`].)
+    pub fn apply(&self, scene: &Scene, name: &str, stages: Stages) -> Result<Settings, Error> {
         let base = if self.tutorial {
             Settings::tutorial(stages)
         } else {
@@ -575,8 +572,8 @@ impl RuleArgs {
 /// The scene and settings a `render` (or `bench`) command line asks for.
 pub fn prepare(args: &FrameArgs) -> Result<(Scene, Settings), Error> {
     let stages = Stages::select(args.stage, &args.without).map_err(Error::Usage)?;
-    let (mut scene, name) = load_scene(&args.scene, args.rules.max_depth)?;
-    let settings = args.rules.apply(&mut scene, &name, stages)?;
+    let (scene, name) = load_scene(&args.scene, args.rules.max_depth)?;
+    let settings = args.rules.apply(&scene, &name, stages)?;
     Ok((scene, settings))
 }
 
@@ -611,9 +608,9 @@ pub fn load_scene(args: &SceneArgs, max_depth: Option<u32>) -> Result<(Scene, St
         Some(path) => scene_file::load_sized(path, size)?,
         None => scene_file::parse_sized(scene_file::SEED_TOML, scene_file::SEED_NAME, size)?,
     };
-    warn_if_empty(&scene, &scene_name(args));
-    warn_if_stretched(&scene, &scene_name(args));
-    Ok((scene, scene_name(args)))
+    let name = scene_name(args);
+    warn_if_unlikely(&scene, &name);
+    Ok((scene, name))
 }
 
 /// `v` to four decimal places, without trailing zeros: 2, 0.5334, 133334.6667.
@@ -624,7 +621,7 @@ fn four_places(v: f64) -> String {
 /// A `[screen]` whose shape is not the image's: valid (chapter 2's second
 /// exercise makes one), but the pixels are not square and the picture comes out
 /// stretched, which a reader should hear of. Shapes within 1 % of each other pass.
-pub fn warn_if_stretched(scene: &Scene, name: &str) {
+fn warn_if_stretched(scene: &Scene, name: &str) {
     let Some(screen) = scene.screen else {
         return;
     };
@@ -643,8 +640,16 @@ pub fn warn_if_stretched(scene: &Scene, name: &str) {
     }
 }
 
+/// What a valid scene may hold that was almost surely not meant, said as
+/// warnings (every command that loads a scene says them): no objects, or
+/// pixels that are not square.
+pub fn warn_if_unlikely(scene: &Scene, name: &str) {
+    warn_if_empty(scene, name);
+    warn_if_stretched(scene, name);
+}
+
 /// A scene without objects is valid, but almost surely not what was meant.
-pub fn warn_if_empty(scene: &Scene, name: &str) {
+fn warn_if_empty(scene: &Scene, name: &str) {
     if scene.objects.is_empty() {
         to_stderr(format_args!(
             "warning: {name}: the scene has no [[sphere]] and no [[plane]], so every ray \

@@ -15,7 +15,7 @@ use crate::render::Settings;
 use crate::scene::{Role, Scene, Shape};
 use crate::stages::{Engine, Stage, Stages};
 use crate::tools::args::{
-    check_pixel, load_scene, prepare, scene_name, warn_if_empty, AccuracyArgs, BenchArgs,
+    check_pixel, load_scene, prepare, scene_name, warn_if_unlikely, AccuracyArgs, BenchArgs,
     ChartArgs, CheckArgs, Cli, Command, DiffArgs, ExplainArgs, FiguresArgs, Generated, RenderArgs,
     StagesArgs,
 };
@@ -249,8 +249,8 @@ pub const CONTACT_SHEET: &str = "contact-sheet.png";
 
 fn stages(args: StagesArgs) -> Result<(), Error> {
     args.refuse_render_flags()?;
-    let (mut scene, name) = load_scene(&args.scene, args.rules.max_depth)?;
-    let base = args.rules.apply(&mut scene, &name, Stages::ALL)?;
+    let (scene, name) = load_scene(&args.scene, args.rules.max_depth)?;
+    let base = args.rules.apply(&scene, &name, Stages::ALL)?;
     // Every file of every stage is renamed into place at the end, together: an
     // error or Ctrl-C on the way leaves the folder as it was.
     let mut pending = Pending::new()
@@ -818,8 +818,7 @@ fn check(args: &CheckArgs) -> Result<(), Error> {
     let path = &args.scene;
     let name = scene_file::display_name(path);
     let scene = scene_file::load(path)?;
-    warn_if_empty(&scene, &name);
-    crate::tools::args::warn_if_stretched(&scene, &name);
+    warn_if_unlikely(&scene, &name);
     if args.json {
         return say_json(scene_json(&scene, &name, true), true);
     }
