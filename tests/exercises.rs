@@ -723,6 +723,25 @@ fn chapter_04_exercise_1_a_step_too_large_lights_the_dark_sides_but_one_patch() 
     }
     assert!((700..=900).contains(&dark_before), "{dark_before}");
     assert!((180..=280).contains(&patch), "a patch of {patch} pixels");
+    // Why no red pixel lies in the green sphere's shadow with the tutorial's
+    // step: the cone of rays from the light that graze the green sphere passes
+    // 0.7097 from the red centre (the answer's number), 0.0097 outside its
+    // radius. A point at angle β from the cone's axis and distance d from its
+    // apex is d·sin(β − α) from the cone, α the cone's half-angle.
+    let sphere = |o: usize| match seed.objects[o].shape {
+        Shape::Sphere(s) => s,
+        Shape::Plane(_) => unreachable!("object {o} is a sphere"),
+    };
+    let (green, red) = (sphere(GREEN), sphere(RED));
+    let (axis, to_red) = (
+        green.center - seed.light.position,
+        red.center - seed.light.position,
+    );
+    let alpha = (green.radius / axis.length()).asin();
+    let beta = axis.angle_between(to_red);
+    let nearest = to_red.length() * (beta - alpha).sin();
+    assert!((nearest - 0.7097).abs() < 5e-5, "{nearest}");
+    assert!(nearest > red.radius, "{nearest}");
     assert!((20..=70).contains(&sliver), "a sliver of {sliver} pixels");
 }
 
