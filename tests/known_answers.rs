@@ -674,7 +674,8 @@ fn the_same_bytes_on_one_thread_and_on_four() {
 /// holds the picture `visualise` draws and the EXR the bytes `exr_bytes_as`
 /// gives, in one-line blocks (no compression) and 16-line ones (ZIP), over
 /// several windows (300 lines at 130 wide is two), and every file's bytes are the
-/// same on one thread and on three.
+/// same on one thread and on three. The rows written are told as each window is
+/// done (the progress bar's second half): every row once, in more than one step.
 #[test]
 fn the_files_written_hold_the_pictures_and_the_exr_on_any_thread_count() {
     use raystep::io::output::{exr_bytes_as, visualise, ExrCompression, Pending};
@@ -689,7 +690,13 @@ fn the_files_written_hold_the_pictures_and_the_exr_on_any_thread_count() {
             pool.install(|| {
                 let mut pending = Pending::new().with_exr(compression);
                 pending.folder(dir.path()).unwrap();
-                let paths = pending.frame(&frame, dir.path()).unwrap();
+                let told = std::sync::Mutex::new(Vec::new());
+                let paths = pending
+                    .frame_counted(&frame, dir.path(), &|n| told.lock().unwrap().push(n))
+                    .unwrap();
+                let told: Vec<u64> = told.into_inner().unwrap();
+                assert_eq!(told.iter().sum::<u64>(), 300, "{told:?}");
+                assert!(told.iter().filter(|&&n| n > 0).count() >= 2, "{told:?}");
                 pending.commit().unwrap();
                 paths
                     .iter()

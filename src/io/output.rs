@@ -247,6 +247,19 @@ impl Pending {
     /// `write_files`), so no copy of the buffers is made: at 1920 × 1080 the
     /// frame's 108 MB is most of what the whole render holds in memory.
     pub fn frame(&mut self, frame: &Frame, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+        self.frame_counted(frame, dir, &|_| {})
+    }
+
+    /// [`Pending::frame`], telling `rows_written` how many more of the frame's
+    /// rows are in every file each time a block of them has been written (in
+    /// all, the frame's height), as `render` tells its rows traced: what the
+    /// command line's bar counts while the files are written.
+    pub fn frame_counted(
+        &mut self,
+        frame: &Frame,
+        dir: &Path,
+        rows_written: &(dyn Fn(u64) + Sync),
+    ) -> Result<Vec<PathBuf>, Error> {
         let buffers: Vec<Buffer> = frame.buffers().collect();
         let mut paths: Vec<PathBuf> = buffers
             .iter()
@@ -255,7 +268,8 @@ impl Pending {
         paths.push(dir.join(EXR_FILE));
         let earlier = earlier_buffers(&dir.join(EXR_FILE));
         let temporaries: Vec<PathBuf> = paths.iter().map(|p| self.register(p)).collect();
-        write_files(frame, &buffers, self.png, self.exr, &temporaries, &paths)?;
+        let files = (temporaries.as_slice(), paths.as_slice());
+        write_files(frame, &buffers, self.png, self.exr, files, rows_written)?;
         self.stale.extend(
             earlier
                 .into_iter()
@@ -1100,7 +1114,15 @@ pub fn exr_to<W: Write + Seek + Send>(
     writer: W,
     compression: ExrCompression,
 ) -> exr::error::UnitResult {
-    stream_files(frame, writer, compression, None, &mut [], &Mutex::new(None))
+    let failed = Mutex::new(None);
+    stream_files(
+        frame,
+        writer,
+        compression,
+        None,
+        (&mut [], &failed),
+        &|_| {},
+    )
 }
 
 /// The pictures [`stream_files`] writes beside the EXR: how to draw them, which
@@ -1110,6 +1132,13 @@ type Pictures<'a, 'b> = Option<(&'a Palette<'b>, &'a [Buffer])>;
 /// A PNG file being written, its picture's rows handed to it in order.
 type PngStream = png::StreamWriter<'static, BufWriter<fs::File>>;
 
+/// The PNG streams [`stream_files`] writes the pictures to, and where a stream
+/// that fails leaves its index and error.
+type PngStreams<'a> = (
+    &'a mut [PngStream],
+    &'a Mutex<Option<(usize, std::io::Error)>>,
+);
+
 /// Write the EXR file of a frame to `writer`, and each picture of `pictures` to
 /// its PNG stream in `streams`, in one pass over the records: block of scan
 /// lines after block (1 to 32 lines, as the compression groups them), each
@@ -1118,14 +1147,15 @@ type PngStream = png::StreamWriter<'static, BufWriter<fs::File>>;
 /// in parallel on rayon's threads while the blocks before them are written:
 /// the EXR's chunks in order, and each picture's rows to its PNG stream, the
 /// files in parallel. Every file's bytes are the same whatever the thread count.
-/// A PNG stream that fails leaves its index and error in `failed`.
+/// A PNG stream that fails leaves its index and error in `failed`. Each time a
+/// block has been written to every file, `rows_written` is told its lines.
 fn stream_files<W: Write + Seek + Send>(
     frame: &Frame,
     writer: W,
     compression: ExrCompression,
     pictures: Pictures,
-    streams: &mut [PngStream],
-    failed: &Mutex<Option<(usize, std::io::Error)>>,
+    (streams, failed): PngStreams,
+    rows_written: &(dyn Fn(u64) + Sync),
 ) -> exr::error::UnitResult {
     let size = Vec2(frame.width as usize, frame.height as usize);
     let mut channels: Vec<(&str, usize)> = (EXR_CHANNELS.iter().enumerate())
@@ -1174,6 +1204,7 @@ fn stream_files<W: Write + Seek + Send>(
                             index_in_header,
                             chunk,
                             rows,
+                            lines: index.pixel_size.height() as u64,
                         })
                     })
                     .collect()
@@ -1184,10 +1215,11 @@ fn stream_files<W: Write + Seek + Send>(
                     || make(some),
                     || put(std::mem::take(&mut ready), chunks, streams, failed),
                 );
-                written?;
+                rows_written(written?);
                 ready = made?;
             }
-            put(ready, chunks, streams, failed)
+            rows_written(put(ready, chunks, streams, failed)?);
+            Ok(())
         },
     )
 }
@@ -1198,17 +1230,21 @@ struct Block {
     index_in_header: usize,
     chunk: exr::block::chunk::Chunk,
     rows: Vec<u8>,
+    /// How many scan lines it holds.
+    lines: u64,
 }
 
 /// Write `blocks` (in order): their chunks to the EXR, and each picture's rows to
 /// its PNG stream, the files in parallel. A PNG stream that fails leaves its
-/// index and error in `failed`, and the write is aborted.
+/// index and error in `failed`, and the write is aborted. Returns how many scan
+/// lines were written.
 fn put(
     blocks: Vec<Block>,
     chunks: &mut (impl ChunksWriter + Send),
     streams: &mut [PngStream],
     failed: &Mutex<Option<(usize, std::io::Error)>>,
-) -> exr::error::UnitResult {
+) -> exr::error::Result<u64> {
+    let lines = blocks.iter().map(|block| block.lines).sum();
     let (exr_chunks, rows): (Vec<_>, Vec<_>) = blocks
         .into_iter()
         .map(|block| ((block.index_in_header, block.chunk), block.rows))
@@ -1235,7 +1271,7 @@ fn put(
                 })
         },
     );
-    exr.and(pngs)
+    exr.and(pngs).map(|()| lines)
 }
 
 /// The uncompressed bytes of one block of scan lines, and its rows of every
@@ -1324,14 +1360,15 @@ pub fn exr_bytes_as(frame: &Frame, compression: ExrCompression) -> Result<Vec<u8
 
 /// Write the files of `frame`: the picture of each of `buffers` as a PNG file
 /// to `temporaries[k]`, and the EXR file to the last of `temporaries`, in one
-/// pass ([`stream_files`]); errors are reported against the final `paths`.
+/// pass ([`stream_files`], which tells `rows_written` of each block written);
+/// errors are reported against the final `paths`.
 fn write_files(
     frame: &Frame,
     buffers: &[Buffer],
     png: PngEncoding,
     compression: ExrCompression,
-    temporaries: &[PathBuf],
-    paths: &[PathBuf],
+    (temporaries, paths): (&[PathBuf], &[PathBuf]),
+    rows_written: &(dyn Fn(u64) + Sync),
 ) -> Result<(), Error> {
     let fail = |k: usize, message: String| Error::Output {
         path: paths[k].clone(),
@@ -1357,8 +1394,8 @@ fn write_files(
         &mut writer,
         compression,
         Some((&palette, buffers)),
-        &mut streams,
-        &failed,
+        (&mut streams, &failed),
+        rows_written,
     );
     if let Some((k, e)) = failed.into_inner().unwrap_or_else(|e| e.into_inner()) {
         return Err(fail(k, e.to_string()));

@@ -271,7 +271,7 @@ fn stages(args: StagesArgs) -> Result<(), Error> {
         scene.height,
         base.engine
     );
-    let bar = job_bar(u64::from(scene.height) * Stage::ALL.len() as u64, "rows");
+    let bar = job_bar(u64::from(scene.height) * Stage::ALL.len() as u64);
     let start = Instant::now();
     let mut page = Vec::new(); // a row of index.html per stage
     let mut sheet = crate::io::contact::ContactSheet::new(crate::io::contact::THUMBNAIL_WIDTH)
@@ -374,7 +374,7 @@ fn render_one(args: RenderArgs) -> Result<(), Error> {
         scene.height,
         settings.engine
     );
-    let bar = job_bar(u64::from(scene.height), "rows");
+    let bar = job_bar(u64::from(scene.height));
     bar.set_message("rendering");
     let (frame, seconds) = timed(|| render(&scene, &settings, &|n| bar.inc(n)));
     crate::error::check_interrupt()?;
@@ -432,7 +432,7 @@ fn write(
 ) -> Result<(Vec<PathBuf>, f64), Error> {
     let phase = bar.message().replace("rendering", "writing files");
     bar.set_message(phase);
-    let (written, write_seconds) = timed(|| pending.frame(frame, dir));
+    let (written, write_seconds) = timed(|| pending.frame_counted(frame, dir, &|n| bar.inc(n)));
     let written = written?;
     let names: Vec<String> = written
         .iter()
@@ -586,10 +586,12 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
     (value, start.elapsed().as_secs_f64())
 }
 
-/// One bar on stderr for a whole job of `len` `unit`s, its phase named in the
-/// message ("rendering", "writing files"); ticking on its own, so that a long
-/// write does not look stalled.
-fn job_bar(len: u64, unit: &str) -> ProgressBar {
+/// One bar on stderr for a whole job that renders `rows` rows in all (a frame's
+/// height, or the six stages' heights): each row counts twice, once traced and
+/// once written to every file, so the bar goes on through the writing. Its phase
+/// is named in the message ("rendering", "writing files") and the bar shows the
+/// share done; it ticks on its own, so that a long write does not look stalled.
+fn job_bar(rows: u64) -> ProgressBar {
     // As wide as the longest phase, "writing files 02-intersection", so that the
     // bar stays where it is from phase to phase.
     let widest = Stage::ALL
@@ -598,22 +600,29 @@ fn job_bar(len: u64, unit: &str) -> ProgressBar {
         .max()
         .unwrap_or(0);
     let label = format!("{{msg:<{}}}", "writing files ".len() + widest);
-    let bar = counted_bar(len, &label, unit);
+    let bar = styled_bar(2 * rows, &format!("{label} [{{bar:30}}] {{percent:>3}} %"));
     bar.enable_steady_tick(std::time::Duration::from_millis(250));
     bar
 }
 
 /// A bar on stderr counting `len` `unit`s after `label`, drawn only when stderr is
-/// a terminal and not `--quiet`. The time left shows only once 5 % is done and
-/// half a second has passed: a first guess from the first rows is far off.
+/// a terminal and not `--quiet`.
 fn counted_bar(len: u64, label: &str, unit: &str) -> ProgressBar {
+    styled_bar(len, &format!("{label} [{{bar:30}}] {{pos}}/{{len}} {unit}"))
+}
+
+/// A bar on stderr of `len` steps drawn as `shown` followed by the time spent and
+/// the time left, only when stderr is a terminal and not `--quiet`. The time left
+/// shows only once 5 % is done and half a second has passed: a first guess from
+/// the first rows is far off.
+fn styled_bar(len: u64, shown: &str) -> ProgressBar {
     let target = if quiet() {
         ProgressDrawTarget::hidden()
     } else {
         ProgressDrawTarget::stderr()
     };
     let bar = ProgressBar::with_draw_target(Some(len), target);
-    let template = format!("{label} [{{bar:30}}] {{pos}}/{{len}} {unit}, {{elapsed}}{{left}}");
+    let template = format!("{shown}, {{elapsed}}{{left}}");
     let left = |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
         let done = state.fraction();
         if (0.05..1.0).contains(&done) && state.elapsed().as_secs_f64() >= 0.5 {
