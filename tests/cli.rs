@@ -1372,6 +1372,48 @@ fn a_scene_typed_at_a_terminal_is_announced_before_it_is_read() {
     assert!(notice < report, "{said}");
 }
 
+/// At a terminal, the job's one bar goes on through the writing (README: each
+/// row counts twice, traced, then written): at 1280 × 720 the write phase of a
+/// debug build takes most of a second, and the bar is drawn in it between 50 %
+/// (every row traced) and 100 %.
+#[test]
+fn the_bar_at_a_terminal_counts_the_rows_written_too() {
+    if common::required(terminal_runner(), "the terminal test").is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let command = format!(
+        "'{}' render --width 1280 --height 720 --out out",
+        env!("CARGO_BIN_EXE_raystep")
+    );
+    let out = Command::new("script")
+        .args(["-qec", &command, "/dev/null"])
+        .current_dir(dir.path())
+        .stdin(std::process::Stdio::null())
+        .output()
+        .unwrap();
+    let said = text(&out.stdout);
+    assert!(out.status.success(), "{said}{}", text(&out.stderr));
+    // Each drawing of the bar: its phase, then "] NN %".
+    let shares = |phase: &str| -> Vec<u32> {
+        said.split(phase)
+            .skip(1)
+            .filter_map(|rest| {
+                let share = rest.split_once(']')?.1.split_once('%')?.0;
+                share.trim().parse().ok()
+            })
+            .collect()
+    };
+    let (traced, written) = (shares("rendering"), shares("writing files"));
+    assert!(traced.iter().all(|&p| p <= 50), "{traced:?}");
+    assert!(written.iter().all(|&p| p >= 50), "{written:?}");
+    assert!(
+        written.iter().any(|&p| 50 < p && p < 100),
+        "no drawing while the files were written: {written:?}\n{said}"
+    );
+    assert_eq!(written.iter().max(), Some(&100), "{written:?}");
+}
+
 #[test]
 fn no_help_shows_rustdoc_syntax() {
     let dir = tempfile::tempdir().unwrap();
