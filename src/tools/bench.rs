@@ -315,7 +315,12 @@ pub fn median(mut times: Vec<f64>) -> f64 {
     }
 }
 
-/// The peak resident memory of this process, from `/proc/self/status` (`VmHWM`).
+/// The peak resident memory of this process, from `/proc/self/status` (`VmHWM`;
+/// `None` where there is no `/proc`). Not `getrusage`'s `ru_maxrss`, portable as
+/// it is: Linux carries it over `execve` from the program the process was
+/// before, so raystep started by a larger process (a test harness, a script)
+/// would report that one's peak. Python allocating 500 MiB and then exec'ing a
+/// small Python that reads both: `ru_maxrss` 520,204 KiB, `VmHWM` 8,128 KiB.
 pub fn peak_memory_bytes() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
@@ -426,6 +431,24 @@ fn count_threads(n: usize) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The peak is at least what is resident now (read before it: the peak can
+    /// only rise), which includes memory just written. (Other tests run beside
+    /// this one, so nothing sharper holds.)
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn the_peak_memory_holds_what_is_resident() {
+        let size = 64 << 20;
+        let written = std::hint::black_box(vec![1u8; size]);
+        let status = std::fs::read_to_string("/proc/self/status").unwrap();
+        let line = status.lines().find(|l| l.starts_with("VmRSS:")).unwrap();
+        let kib: u64 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
+        let resident = kib * 1024;
+        let peak = peak_memory_bytes().expect("/proc/self/status");
+        assert!(resident >= size as u64, "{resident}");
+        assert!(peak >= resident, "peak {peak}, resident {resident}");
+        drop(written);
+    }
 
     #[test]
     fn the_median_takes_the_middle() {
