@@ -7,7 +7,8 @@
 //! dependencies build in seconds. Each of the [`RENDERS_AT_ONCE`] renders runs
 //! on a rayon pool of its own: in one shared pool a render that came second
 //! waited for the first one's rows (a 30 × 20 preview behind a 1080p render
-//! took the whole 1.5 s of the large one), since a pool's threads finish the
+//! took the whole 1.5 s of the large one: curl against `raystep serve` before
+//! commit e7af856, whose message has the figures), since a pool's threads finish the
 //! work they have split before they take new work from outside.
 //!
 //! Safety, since a server is an attack surface:
