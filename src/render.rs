@@ -504,7 +504,8 @@ pub fn in_rows(
     // 100,000 spheres under an empty sky), one thread was still in a long run at
     // the end while the other waited. Two threads then traced 1.86 times as fast
     // as one (median of seven rounds of `raystep bench`, before and at commit
-    // 1400927), and 1.96 with rows as tasks; figure 1, whose costs are spread, is the same either way.
+    // 1400927), and 1.96 with rows as tasks; figure 1, whose costs are spread,
+    // is the same either way.
     let rays = frame
         .pixels
         .par_chunks_mut(width)
