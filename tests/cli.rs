@@ -12,11 +12,26 @@ fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
+/// Fails, showing all of `output`, unless it holds `wanted`.
+#[track_caller]
+fn says(output: &[u8], wanted: &str) {
+    let output = text(output);
+    assert!(output.contains(wanted), "no {wanted:?} in:\n{output}");
+}
+
+/// Run raystep in `dir` with `args`, which must succeed (else its stderr is
+/// shown).
+#[track_caller]
+fn succeeds(dir: &Path, args: &[&str]) -> std::process::Output {
+    let out = raystep(dir, args);
+    assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
+    out
+}
+
 /// Run raystep in `dir` with `args`, which must succeed, and read the JSON it
 /// prints.
 fn json_of(dir: &Path, args: &[&str]) -> serde_json::Value {
-    let out = raystep(dir, args);
-    assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
+    let out = succeeds(dir, args);
     serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{args:?}: {e}"))
 }
 
@@ -53,8 +68,7 @@ fn png_size(path: &Path) -> (u32, u32) {
 #[test]
 fn no_arguments_renders_every_stage_of_the_built_in_scene_from_any_folder() {
     let dir = tempfile::tempdir().unwrap();
-    let out = raystep(dir.path(), &[]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = succeeds(dir.path(), &[]);
     // Nothing on stdout, which is for data; the status lines on stderr, with no
     // progress bar (stderr is not a terminal) and no warnings.
     assert_eq!(text(&out.stdout), "");
@@ -124,10 +138,12 @@ fn render_writes_one_configuration_at_the_size_asked_and_no_temporary_files() {
         "--out",
         "here",
     ];
-    let out = raystep(dir.path(), &args);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = succeeds(dir.path(), &args);
     assert_eq!(text(&out.stdout), "", "stdout is for data");
-    assert!(text(&out.stderr).contains("rays+intersection+blinn-phong+reflection+plane"));
+    says(
+        &out.stderr,
+        "rays+intersection+blinn-phong+reflection+plane",
+    );
     let mut names: Vec<String> = std::fs::read_dir(dir.path().join("here"))
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -200,8 +216,7 @@ fn chapter_one_shows_what_check_prints() {
     // repository's root, is the command's output as it is now.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let shown = common::transcript("01-scene.md", "raystep check scenes/seed.toml");
-    let out = raystep(root, &["check", "scenes/seed.toml"]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = succeeds(root, &["check", "scenes/seed.toml"]);
     assert_eq!(shown, text(&out.stdout));
 }
 
@@ -211,11 +226,10 @@ fn check_counts_the_spheres_past_the_first_twenty() {
     // and --json list all 30 (a scene of a million would otherwise print two
     // million lines).
     let dir = tempfile::tempdir().unwrap();
-    let out = raystep(
+    let out = succeeds(
         dir.path(),
         &["generate", "spheres", "--count", "30", "--seed", "3"],
     );
-    assert!(out.status.success(), "{}", text(&out.stderr));
     std::fs::write(dir.path().join("thirty.toml"), &out.stdout).unwrap();
     let listed = |stdout: &str| {
         stdout
@@ -399,16 +413,11 @@ fn diff_compares_two_renders_and_refuses_two_sizes() {
 
     let same = run(&["diff", "a/buffers.exr", "a/buffers.exr"]);
     assert_eq!(same.status.code(), Some(0), "the same: exit 0");
-    assert!(
-        text(&same.stdout).contains("differ by more than 1/255: 0 pixels (0.00 %)"),
-        "{}",
-        text(&same.stdout)
-    );
+    says(&same.stdout, "differ by more than 1/255: 0 pixels (0.00 %)");
     // No place is named for the largest of no differences.
-    assert!(
-        text(&same.stdout).contains("largest difference:        0 (the images are the same)\n"),
-        "{}",
-        text(&same.stdout)
+    says(
+        &same.stdout,
+        "largest difference:        0 (the images are the same)\n",
     );
 
     let other = run(&["diff", "a/buffers.exr", "b/buffers.exr"]);
@@ -418,15 +427,18 @@ fn diff_compares_two_renders_and_refuses_two_sizes() {
         "different: exit 1, as diff and cmp"
     );
     assert!(!text(&other.stdout).contains("differ by more than 1/255: 0 pixels"));
-    assert!(text(&other.stdout).contains("largest difference:        0."));
+    says(&other.stdout, "largest difference:        0.");
 
     let sizes = run(&["diff", "a/buffers.exr", "small/buffers.exr"]);
     assert_eq!(sizes.status.code(), Some(2));
-    assert!(text(&sizes.stderr).contains("60 × 40 but small/buffers.exr is 30 × 20"));
+    says(&sizes.stderr, "60 × 40 but small/buffers.exr is 30 × 20");
 
     let not_exr = run(&["diff", "a/buffers.exr", "a/beauty.png"]);
     assert_eq!(not_exr.status.code(), Some(2));
-    assert!(text(&not_exr.stderr).contains("a/beauty.png: cannot read it as an EXR file"));
+    says(
+        &not_exr.stderr,
+        "a/beauty.png: cannot read it as an EXR file",
+    );
 }
 
 #[test]
@@ -462,14 +474,13 @@ fn size_flags_override_a_size_the_file_gets_wrong() {
         scene_with("[image]\nwidth = 20000\n"),
     )
     .unwrap();
-    let out = raystep(
+    succeeds(
         dir.path(),
         &["render", "big.toml", "--width", "40", "--height", "30"],
     );
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let out = raystep(dir.path(), &["check", "big.toml"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(text(&out.stderr).contains("image.width = 20000"));
+    says(&out.stderr, "image.width = 20000");
 }
 
 #[test]
@@ -506,11 +517,7 @@ fn max_depth_overrides_a_depth_the_file_gets_wrong_as_the_size_flags_do() {
     // Without the flag the file's value is still checked, and named.
     let out = raystep(dir.path(), &["render", "deep.toml", "-q"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(
-        text(&out.stderr).contains("render.max_depth = 100: must be from 1 to 64"),
-        "{}",
-        text(&out.stderr)
-    );
+    says(&out.stderr, "render.max_depth = 100: must be from 1 to 64");
 }
 
 #[test]
@@ -560,8 +567,7 @@ fn bench_prints_one_json_object_with_the_promised_keys() {
 fn bench_reports_a_bvh_from_24_spheres_on() {
     let dir = tempfile::tempdir().unwrap();
     for (count, tree) in [("23", false), ("24", true)] {
-        let out = raystep(dir.path(), &["generate", "spheres", "--count", count]);
-        assert!(out.status.success(), "{}", text(&out.stderr));
+        let out = succeeds(dir.path(), &["generate", "spheres", "--count", count]);
         let file = format!("{count}.toml");
         std::fs::write(dir.path().join(&file), &out.stdout).unwrap();
         let json = json_of(
@@ -664,11 +670,10 @@ fn bench_json_derives_each_ratio_from_the_times_it_names() {
 #[test]
 fn generate_writes_a_scene_that_loads_and_refuses_a_count_of_zero() {
     let dir = tempfile::tempdir().unwrap();
-    let out = raystep(
+    let out = succeeds(
         dir.path(),
         &["generate", "spheres", "--count", "25", "--seed", "4"],
     );
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let scene = raystep::io::scene_file::parse(&text(&out.stdout), "generated").unwrap();
     assert_eq!(scene.objects.len(), 26, "25 spheres and the floor");
     let again = raystep(
@@ -683,11 +688,10 @@ fn generate_writes_a_scene_that_loads_and_refuses_a_count_of_zero() {
 #[test]
 fn generate_writes_a_million_spheres_as_their_recipe_and_the_recipe_loads() {
     let dir = tempfile::tempdir().unwrap();
-    let out = raystep(
+    let out = succeeds(
         dir.path(),
         &["generate", "spheres", "--count", "1000000", "--seed", "7"],
     );
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let file = text(&out.stdout);
     assert!(
         file.len() < 1000,
@@ -712,7 +716,7 @@ fn generate_writes_a_million_spheres_as_their_recipe_and_the_recipe_loads() {
         &["generate", "spheres", "--count", "40", "--recipe"],
     );
     assert!(text(&recipe.stderr).is_empty(), "{}", text(&recipe.stderr));
-    assert!(text(&recipe.stdout).contains("[generate]\nspheres = 40\nseed = 1\n"));
+    says(&recipe.stdout, "[generate]\nspheres = 40\nseed = 1\n");
     assert_eq!(
         raystep::io::scene_file::parse(&text(&recipe.stdout), "recipe").unwrap(),
         raystep::io::scene_file::parse(&text(&list.stdout), "list").unwrap()
@@ -722,13 +726,12 @@ fn generate_writes_a_million_spheres_as_their_recipe_and_the_recipe_loads() {
 #[test]
 fn chart_writes_its_csv_svg_and_png_and_its_errors_rank_the_settings_as_chapter_10_says() {
     let dir = tempfile::tempdir().unwrap();
-    let out = raystep(
+    succeeds(
         dir.path(),
         &[
             "chart", "--width", "32", "--height", "18", "--runs", "1", "--out", "c",
         ],
     );
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let csv = std::fs::read_to_string(dir.path().join("c/chart.csv")).unwrap();
     assert_eq!(csv.lines().count(), 18, "a header and 17 settings: {csv}");
     assert_eq!(png_size(&dir.path().join("c/chart.png")), (960, 640));
@@ -868,10 +871,9 @@ fn diff_places_the_largest_difference_at_its_row_and_column() {
         );
         assert_eq!(report["over_one_step"], 2, "{report}");
         let said = raystep(dir.path(), &["diff", a, b]);
-        assert!(
-            text(&said.stdout).contains("largest difference:        0.5000 (row 5, column 17)"),
-            "{}",
-            text(&said.stdout)
+        says(
+            &said.stdout,
+            "largest difference:        0.5000 (row 5, column 17)",
         );
     }
 }
@@ -896,10 +898,9 @@ fn diff_gives_the_share_of_differing_pixels_in_percent_and_fails_above_fail_perc
     let percent = report["over_threshold_percent"].as_f64().unwrap();
     assert!((percent - 0.5).abs() < 1e-9, "{report}");
     let said = raystep(dir.path(), &["diff", "a.exr", "b.exr"]);
-    assert!(
-        text(&said.stdout).contains("different: 3 pixels (0.50 %) differ by more than"),
-        "{}",
-        text(&said.stdout)
+    says(
+        &said.stdout,
+        "different: 3 pixels (0.50 %) differ by more than",
     );
     for (allowed, code) in [("0.4", 1), ("0.5", 0), ("0.6", 0)] {
         let out = raystep(
@@ -963,11 +964,7 @@ fn generate_lists_100000_spheres_and_writes_the_recipe_of_100001() {
         file.contains("[generate]\nspheres = 100001\nseed = 1\n") && !file.contains("[[sphere]]"),
         "{file}"
     );
-    assert!(
-        text(&recipe.stderr).contains("recipe"),
-        "{}",
-        text(&recipe.stderr)
-    );
+    says(&recipe.stderr, "recipe");
     // `-q` silences that note too; the scene still goes to standard output.
     let quiet = raystep(
         dir.path(),
@@ -1187,8 +1184,7 @@ fn status_lines_go_to_stderr_and_quiet_silences_them() {
     for command in ["render", "stages"] {
         let mut args = vec![command];
         args.extend(size);
-        let out = raystep(dir.path(), &args);
-        assert!(out.status.success(), "{}", text(&out.stderr));
+        let out = succeeds(dir.path(), &args);
         assert_eq!(text(&out.stdout), "", "{command}: stdout is for data");
         let stderr = text(&out.stderr);
         assert!(stderr.contains("24 × 16"), "{command}: {stderr}");
@@ -1196,8 +1192,7 @@ fn status_lines_go_to_stderr_and_quiet_silences_them() {
         for quiet in ["-q", "--quiet"] {
             let mut args = vec![quiet, command];
             args.extend(size);
-            let out = raystep(dir.path(), &args);
-            assert!(out.status.success(), "{}", text(&out.stderr));
+            let out = succeeds(dir.path(), &args);
             assert_eq!(text(&out.stdout), "", "{quiet} {command}");
             assert_eq!(text(&out.stderr), "", "{quiet} {command}");
         }
@@ -1217,8 +1212,7 @@ fn status_lines_go_to_stderr_and_quiet_silences_them() {
 #[test]
 fn completions_and_a_man_page() {
     let dir = tempfile::tempdir().unwrap();
-    let bash = raystep(dir.path(), &["completions", "bash"]);
-    assert!(bash.status.success(), "{}", text(&bash.stderr));
+    let bash = succeeds(dir.path(), &["completions", "bash"]);
     let script = text(&bash.stdout);
     assert!(script.contains("raystep"), "{script}");
     assert!(script.contains("complete"), "{script}");
@@ -1231,8 +1225,7 @@ fn completions_and_a_man_page() {
         raystep(dir.path(), &["completions", "tcsh"]).status.code(),
         Some(2)
     );
-    let man = raystep(dir.path(), &["man"]);
-    assert!(man.status.success(), "{}", text(&man.stderr));
+    let man = succeeds(dir.path(), &["man"]);
     let page = text(&man.stdout);
     let first = page
         .lines()
@@ -1323,11 +1316,7 @@ fn a_scene_on_stdin_and_output_aliases() {
     // serve follows its file, so it cannot take one from stdin: a message, exit 2.
     let serve = raystep_with_input(dir.path(), &["serve", "-", "--port", "0"], &seed);
     assert_eq!(serve.status.code(), Some(2));
-    assert!(
-        text(&serve.stderr).contains("cannot take one from standard input"),
-        "{}",
-        text(&serve.stderr)
-    );
+    says(&serve.stderr, "cannot take one from standard input");
 }
 
 /// Where `script` (util-linux) runs a command at a terminal of its own.
@@ -1529,11 +1518,10 @@ fn chapter_one_shows_where_a_value_out_of_range_is() {
 fn status_lines_and_refusals_say_what_they_mean() {
     let dir = tempfile::tempdir().unwrap();
     // A folder given with a slash is named with one.
-    let out = raystep(
+    let out = succeeds(
         dir.path(),
         &["render", "--width", "8", "--height", "6", "-o", "r1/"],
     );
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let said = text(&out.stderr);
     assert!(
         said.contains("\n  r1/ ") && !said.contains("r1//"),
@@ -1541,13 +1529,12 @@ fn status_lines_and_refusals_say_what_they_mean() {
     );
     // bench keeps its status line on standard error with --json, and a ratio
     // below 1 reads as one ("0.5× as fast", not "0.5× faster").
-    let out = raystep(
+    let out = succeeds(
         dir.path(),
         &[
             "bench", "--width", "8", "--height", "6", "--runs", "1", "--json",
         ],
     );
-    assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(
         text(&out.stderr).starts_with("scenes/seed.toml (built in): rays+"),
         "{}",
@@ -1569,11 +1556,7 @@ fn status_lines_and_refusals_say_what_they_mean() {
     // An option that means something only with another is refused without it.
     let out = raystep(dir.path(), &["chart", "--max-count", "10"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(
-        text(&out.stderr).contains("--scale"),
-        "{}",
-        text(&out.stderr)
-    );
+    says(&out.stderr, "--scale");
 }
 
 #[test]
@@ -1631,11 +1614,9 @@ fn exr_header(path: &Path) -> exr::meta::header::Header {
 fn the_output_folder_is_out_unless_given_and_stages_takes_both_aliases() {
     let dir = tempfile::tempdir().unwrap();
     let size = ["--width", "12", "--height", "8", "-q"];
-    let out = raystep(dir.path(), &[&["render"][..], &size].concat());
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    succeeds(dir.path(), &[&["render"][..], &size].concat());
     assert_eq!(png_size(&dir.path().join("out/beauty.png")), (12, 8));
-    let out = raystep(dir.path(), &[&["stages"][..], &size].concat());
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    succeeds(dir.path(), &[&["stages"][..], &size].concat());
     assert_eq!(
         png_size(&dir.path().join("out/06-plane/beauty.png")),
         (12, 8)
@@ -1734,31 +1715,28 @@ fn png_and_exr_defaults_and_their_flags_on_render_and_stages() {
     use exr::compression::Compression;
     let dir = tempfile::tempdir().unwrap();
     let size = ["--width", "12", "--height", "8", "-q"];
-    let out = raystep(
+    succeeds(
         dir.path(),
         &[&["render", "-o", "plain"][..], &size].concat(),
     );
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let plain = dir.path().join("plain");
     assert!(!png_chunks(&plain.join("beauty.png")).contains(&"sRGB".to_string()));
     assert_eq!(
         exr_header(&plain.join("buffers.exr")).compression,
         Compression::Uncompressed
     );
-    let out = raystep(
+    succeeds(
         dir.path(),
         &[&["render", "-o", "srgb", "--png", "srgb"][..], &size].concat(),
     );
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let chunks = png_chunks(&dir.path().join("srgb/beauty.png"));
     assert!(chunks.contains(&"sRGB".to_string()), "{chunks:?}");
 
     let flags = ["--png", "srgb", "--exr-compression", "zip"];
-    let out = raystep(
+    succeeds(
         dir.path(),
         &[&["stages", "-o", "st"][..], &flags, &size].concat(),
     );
-    assert!(out.status.success(), "{}", text(&out.stderr));
     for stage in ["01-rays", "06-plane"] {
         let folder = dir.path().join("st").join(stage);
         let chunks = png_chunks(&folder.join("beauty.png"));
