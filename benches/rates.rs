@@ -14,12 +14,17 @@
 //! records: `store_records_*` fills a 1920 × 1080 frame of [`PixelRecord`]s
 //! (52 bytes each, 108 MB) that was written before, as `bench` reuses its frame,
 //! on one thread and on rayon's pool (one thread a core), a row a task as the
-//! engines do. divan's "B/s" is the rate; the time is a frame's store floor.
+//! engines do, one record at a time as the book engine stores them;
+//! `store_packets_*` the same, four records at a time through the fast engine's
+//! own `store_packet` (non-temporal stores). divan's "B/s" is the rate; the time
+//! is a frame's store floor.
 
 use divan::counter::{BytesCount, ItemsCount};
 use divan::Bencher;
 use rayon::prelude::*;
 use raystep::aov::{PixelRecord, RECORD_BYTES};
+use raystep::fast::lanes::WIDTH as LANES;
+use raystep::fast::packet::{finish_stores, store_packet};
 use std::hint::black_box;
 
 fn main() {
@@ -95,15 +100,30 @@ fn div_one_lane(bencher: Bencher) {
 const WIDTH: usize = 1920;
 const HEIGHT: usize = 1080;
 
-/// Fill `line` (row `row`) with records that differ from pixel to pixel, so
-/// that no store can be left out or merged.
+/// The record of pixel `x` of row `row`: records differ from pixel to pixel,
+/// so that no store can be left out or merged.
+#[inline(always)]
+fn record(row: usize, x: usize) -> PixelRecord {
+    let v = (row * WIDTH + x) as f32;
+    let mut r = PixelRecord::missed([v, v + 1.0, v + 2.0], 1, 2);
+    r.set_hit(v, [v, -v, 0.5], x.is_multiple_of(2), x, 0.25, v * 0.5);
+    r
+}
+
+/// Fill `line` (row `row`) record by record.
 fn fill_row(row: usize, line: &mut [PixelRecord]) {
-    for (x, record) in line.iter_mut().enumerate() {
-        let v = (row * WIDTH + x) as f32;
-        let mut r = PixelRecord::missed([v, v + 1.0, v + 2.0], 1, 2);
-        r.set_hit(v, [v, -v, 0.5], x % 2 == 0, x, 0.25, v * 0.5);
-        *record = r;
+    for (x, pixel) in line.iter_mut().enumerate() {
+        *pixel = record(row, x);
     }
+}
+
+/// Fill `line` (row `row`) a packet at a time, as the fast engine does.
+fn fill_row_in_packets(row: usize, line: &mut [PixelRecord]) {
+    for (p, packet) in line.chunks_mut(LANES).enumerate() {
+        let records = std::array::from_fn(|i| record(row, p * LANES + i));
+        store_packet(packet, &records);
+    }
+    finish_stores();
 }
 
 /// Time filling a frame, its pages already touched: `rows` runs `fill_row`
@@ -135,6 +155,26 @@ fn store_records_all_threads(bencher: Bencher) {
             .with_max_len(1)
             .enumerate()
             .for_each(|(row, line)| fill_row(row, line));
+    });
+}
+
+#[divan::bench]
+fn store_packets_one_thread(bencher: Bencher) {
+    store_frame(bencher, |frame| {
+        for (row, line) in frame.chunks_mut(WIDTH).enumerate() {
+            fill_row_in_packets(row, line);
+        }
+    });
+}
+
+#[divan::bench]
+fn store_packets_all_threads(bencher: Bencher) {
+    store_frame(bencher, |frame| {
+        frame
+            .par_chunks_mut(WIDTH)
+            .with_max_len(1)
+            .enumerate()
+            .for_each(|(row, line)| fill_row_in_packets(row, line));
     });
 }
 

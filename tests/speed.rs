@@ -772,3 +772,46 @@ fn accel_auto_builds_the_bvh_from_24_spheres_on() {
         );
     }
 }
+
+#[test]
+fn a_packets_records_are_stored_as_copy_from_slice_would_store_them() {
+    // `store_packet` writes a whole packet on 16 bytes with non-temporal stores
+    // and any other with an ordinary copy: either way the bytes of
+    // `copy_from_slice`, and nothing outside the packet. A record is 52 bytes,
+    // 4 more than a multiple of 16, so of four neighbouring places one starts on
+    // 16 bytes and three do not; every place from 0 to 7 is tried, whole and as
+    // the short packet at a row's end.
+    use raystep::fast::lanes::WIDTH;
+    use raystep::fast::packet::{finish_stores, store_packet};
+    let record = |k: usize| {
+        let v = k as f32 + 0.5;
+        let mut r = PixelRecord::missed([v, -v, v * 3.0], k as u64, 2 * k as u64 + 1);
+        r.set_hit(v, [0.25, -v, 1.0], k.is_multiple_of(2), k, v / 7.0, v * v);
+        r
+    };
+    let records: [PixelRecord; WIDTH] = std::array::from_fn(|i| record(100 + i));
+    let (mut aligned, mut misaligned) = (0, 0);
+    for start in 0..8 {
+        for n in 1..=WIDTH {
+            let mut ours: Vec<PixelRecord> = (0..16).map(record).collect();
+            let mut copied = ours.clone();
+            store_packet(&mut ours[start..start + n], &records);
+            finish_stores();
+            copied[start..start + n].copy_from_slice(&records[..n]);
+            let ours_bits: Vec<_> = ours.iter().map(common::record_bits).collect();
+            let copied_bits: Vec<_> = copied.iter().map(common::record_bits).collect();
+            assert_eq!(ours_bits, copied_bits, "{n} records at {start}");
+            if n == WIDTH {
+                match (ours[start..].as_ptr() as usize).is_multiple_of(16) {
+                    true => aligned += 1,
+                    false => misaligned += 1,
+                }
+            }
+        }
+    }
+    // Both ways of storing a whole packet were taken.
+    assert!(
+        aligned >= 1 && misaligned >= 1,
+        "{aligned} on 16 bytes, {misaligned} not"
+    );
+}

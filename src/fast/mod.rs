@@ -3,8 +3,9 @@
 //! It is built on the book's [`Tracer`](crate::render::Tracer) and reads everything from it: the objects,
 //! the light, the rules, the BVH. What it adds never changes a pixel: rays traced
 //! four at a time in SIMD lanes ([`crate::fast::packet`]), tile masks that skip objects
-//! a tile's primary rays cannot hit ([`TileMasks`](masks::TileMasks)), and a packet walk of the
-//! BVH. `tests/speed.rs` holds it to the book's bits on every scene and setting.
+//! a tile's primary rays cannot hit ([`TileMasks`](masks::TileMasks)), a packet walk of the
+//! BVH, and records stored without first reading in the memory they overwrite
+//! ([`store_packet`](packet::store_packet)). `tests/speed.rs` holds it to the book's bits on every scene and setting.
 //! The book's files never import this one.
 //!
 //! What it does not take in packets (more than [`MAX_OBJECTS`](crate::fast::packet::MAX_OBJECTS) objects without
@@ -90,6 +91,7 @@ impl<T: Laned> Fast<T> {
                 rays += self.pixel_packet(row, first + (k * WIDTH) as u32, primary[k], pixels);
             }
         }
+        crate::fast::packet::finish_stores();
         rays
     }
 

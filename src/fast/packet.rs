@@ -53,7 +53,7 @@
 use std::borrow::Cow;
 
 use crate::accel::Accel;
-use crate::aov::{PixelRecord, Rays};
+use crate::aov::{PixelRecord, Rays, RECORD_BYTES};
 use crate::camera::lerp_on_grid;
 use crate::fast::lanes::{components, convert, each, powi, F64s, Laned, Lanes, ALL, V3, WIDTH};
 use crate::fast::masks::{TileMasks, EVERY, TILE};
@@ -423,7 +423,7 @@ impl<T: Laned> Traced4<T> {
         let (depth, l_dot_n, highlight) =
             (f32s(self.depth), f32s(self.l_dot_n), f32s(self.highlight));
         let normal = [self.normal.x, self.normal.y, self.normal.z].map(f32s);
-        for (i, pixel) in out.iter_mut().enumerate() {
+        let records = each(|i| {
             let on = |bits: u32| bits >> i & 1 == 1;
             let colour = [colour[0][i], colour[1][i], colour[2][i]];
             let bounces = u64::from(self.reflection_rays[i]);
@@ -439,8 +439,9 @@ impl<T: Laned> Traced4<T> {
                     shaded(highlight),
                 );
             }
-            *pixel = record;
-        }
+            record
+        });
+        store_packet(out, &records);
     }
 
     /// Each lane's rays.
@@ -583,6 +584,55 @@ fn count(counts: &mut [u32; WIDTH], bits: u32) {
     }
 }
 
+/// Put a packet's `records` into its pixels `out` (the first `out.len()` of
+/// them): the same bytes as `out.copy_from_slice`. A whole packet whose pixels
+/// start on a multiple of 16 bytes (every packet of a row whose bytes are, as at
+/// 1920 pixels) is written with non-temporal stores (`movntdq`, SSE2, which every
+/// x86-64 processor has): they send the bytes towards memory without first
+/// reading in the cache lines they fill, as an ordinary store must. The frame
+/// (108 MB at 1920 × 1080) is far larger than the caches, so each line would be
+/// read only to be overwritten. `cargo bench --bench rates -- store` fills a
+/// frame both ways (chapter 10). Once a row is done, [`finish_stores`] makes its
+/// records visible to the other threads.
+// ANCHOR: store_packet
+#[inline(always)]
+pub fn store_packet(out: &mut [PixelRecord], records: &[PixelRecord; WIDTH]) {
+    #[cfg(target_arch = "x86_64")]
+    if out.len() == WIDTH && (out.as_ptr() as usize).is_multiple_of(16) {
+        use std::arch::x86_64::{__m128i, _mm_loadu_si128, _mm_stream_si128};
+        const CHUNKS: usize = WIDTH * RECORD_BYTES / 16;
+        const _: () = assert!(CHUNKS * 16 == std::mem::size_of::<[PixelRecord; WIDTH]>());
+        let from = records.as_ptr().cast::<__m128i>();
+        let to = out.as_mut_ptr().cast::<__m128i>();
+        for k in 0..CHUNKS {
+            // SAFETY: `records` and `out` each hold WIDTH records, CHUNKS × 16
+            // bytes; `to` is 16-byte aligned (checked above), as `movntdq`
+            // needs; `_mm_loadu_si128` reads any address; SSE2 is part of x86-64.
+            #[allow(unsafe_code)]
+            unsafe {
+                _mm_stream_si128(to.add(k), _mm_loadu_si128(from.add(k)));
+            }
+        }
+        return;
+    }
+    let n = out.len();
+    out.copy_from_slice(&records[..n]);
+}
+// ANCHOR_END: store_packet
+
+/// Order the non-temporal stores of [`store_packet`] before whatever this
+/// thread does next (`sfence`), so that a thread that learns through rayon that
+/// the row is done also sees its records. (Called at the end of every row.)
+#[inline(always)]
+pub fn finish_stores() {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: `sfence` is SSE, part of x86-64.
+    #[allow(unsafe_code)]
+    unsafe {
+        std::arch::x86_64::_mm_sfence();
+    }
+}
+
 impl<T: Laned> Fast<T> {
     // ANCHOR: packet
     /// The records of pixels `col`, `col + 1`, … of row `row`, one per element of
@@ -608,11 +658,13 @@ impl<T: Laned> Fast<T> {
         let lanes = ALL >> (WIDTH - n);
         let mut total = Rays::default();
         if !self.book.stages.intersection {
-            for (pixel, d) in out.iter_mut().zip(ray.direction.to_vectors()) {
-                let colour = direction_colour(d.to_f64()).clamp(Vec3::ZERO, Vec3::ONE);
-                *pixel = PixelRecord::new(colour, None, 0, 1);
-                total.primary += 1;
-            }
+            let d = ray.direction.to_vectors();
+            let records = each(|i| {
+                let colour = direction_colour(d[i].to_f64()).clamp(Vec3::ZERO, Vec3::ONE);
+                PixelRecord::new(colour, None, 0, 1)
+            });
+            store_packet(out, &records);
+            total.primary += n as u64;
             return total;
         }
         let candidates = self.masks.mask(row, col);
