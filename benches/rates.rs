@@ -126,56 +126,42 @@ fn fill_row_in_packets(row: usize, line: &mut [PixelRecord]) {
     finish_stores();
 }
 
-/// Time filling a frame, its pages already touched: `rows` runs `fill_row`
-/// on every row.
-fn store_frame(bencher: Bencher, rows: fn(&mut [PixelRecord])) {
+/// Time filling a frame, its pages already touched: `fill` on every row, one
+/// after another on this thread, or on all of rayon's threads a row a task.
+fn store_frame(bencher: Bencher, fill: fn(usize, &mut [PixelRecord]), all_threads: bool) {
+    let rows = |frame: &mut [PixelRecord]| match all_threads {
+        true => frame
+            .par_chunks_mut(WIDTH)
+            .with_max_len(1)
+            .enumerate()
+            .for_each(|(row, line)| fill(row, line)),
+        false => (frame.chunks_mut(WIDTH).enumerate()).for_each(|(row, line)| fill(row, line)),
+    };
     let mut frame = vec![PixelRecord::missed([0.0; 3], 0, 0); WIDTH * HEIGHT];
     rows(&mut frame);
     bencher
         .counter(BytesCount::new(WIDTH * HEIGHT * RECORD_BYTES))
-        .bench_local(|| {
-            rows(black_box(&mut frame));
-        });
+        .bench_local(|| rows(black_box(&mut frame)));
 }
 
 #[divan::bench]
 fn store_records_one_thread(bencher: Bencher) {
-    store_frame(bencher, |frame| {
-        for (row, line) in frame.chunks_mut(WIDTH).enumerate() {
-            fill_row(row, line);
-        }
-    });
+    store_frame(bencher, fill_row, false);
 }
 
 #[divan::bench]
 fn store_records_all_threads(bencher: Bencher) {
-    store_frame(bencher, |frame| {
-        frame
-            .par_chunks_mut(WIDTH)
-            .with_max_len(1)
-            .enumerate()
-            .for_each(|(row, line)| fill_row(row, line));
-    });
+    store_frame(bencher, fill_row, true);
 }
 
 #[divan::bench]
 fn store_packets_one_thread(bencher: Bencher) {
-    store_frame(bencher, |frame| {
-        for (row, line) in frame.chunks_mut(WIDTH).enumerate() {
-            fill_row_in_packets(row, line);
-        }
-    });
+    store_frame(bencher, fill_row_in_packets, false);
 }
 
 #[divan::bench]
 fn store_packets_all_threads(bencher: Bencher) {
-    store_frame(bencher, |frame| {
-        frame
-            .par_chunks_mut(WIDTH)
-            .with_max_len(1)
-            .enumerate()
-            .for_each(|(row, line)| fill_row_in_packets(row, line));
-    });
+    store_frame(bencher, fill_row_in_packets, true);
 }
 
 #[cfg(target_arch = "x86_64")]
