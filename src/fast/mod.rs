@@ -5,7 +5,8 @@
 //! four at a time in SIMD lanes ([`crate::fast::packet`]), tile masks that skip objects
 //! a tile's primary rays cannot hit ([`TileMasks`](masks::TileMasks)), a packet walk of the
 //! BVH, and records stored without first reading in the memory they overwrite
-//! ([`store_packet`](packet::store_packet)). `tests/speed.rs` holds it to the book's bits on every scene and setting.
+//! ([`store_packet`](packet::store_packet)). `tests/speed.rs` holds it to the
+//! book's bits on every scene and setting.
 //! The book's files never import this one.
 //!
 //! What it does not take in packets (more than [`MAX_OBJECTS`](crate::fast::packet::MAX_OBJECTS) objects without
