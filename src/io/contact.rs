@@ -128,26 +128,32 @@ impl ContactSheet {
     /// buffer's 8-bit picture scaled to the thumbnail size, or an empty cell when the
     /// frame does not hold that buffer. Only the thumbnails are kept.
     pub fn add_row(&mut self, label: &str, frame: &Frame) {
+        use rayon::iter::{IntoParallelRefIterator, ParallelIterator};
         let (width, height) = thumbnail_size(frame.width, frame.height, self.max_width);
-        let cells = COLUMNS.map(|buffer| {
-            if !frame.buffers().any(|b| b == buffer) {
-                return None;
-            }
-            let picture = RgbImage::from_raw(
-                frame.width,
-                frame.height,
-                crate::io::output::visualise_as(frame, buffer, self.png),
-            )
-            .expect("visualise gives 3 bytes per pixel");
-            Some(if (width, height) == (frame.width, frame.height) {
-                picture
-            } else {
-                imageops::resize(&picture, width, height, FilterType::Triangle)
+        // The columns' pictures drawn and shrunk in parallel (a full-size picture
+        // at a time on each thread).
+        let cells: Vec<Option<RgbImage>> = COLUMNS
+            .par_iter()
+            .map(|&buffer| {
+                if !frame.buffers().any(|b| b == buffer) {
+                    return None;
+                }
+                let picture = RgbImage::from_raw(
+                    frame.width,
+                    frame.height,
+                    crate::io::output::visualise_as(frame, buffer, self.png),
+                )
+                .expect("visualise gives 3 bytes per pixel");
+                Some(if (width, height) == (frame.width, frame.height) {
+                    picture
+                } else {
+                    imageops::resize(&picture, width, height, FilterType::Triangle)
+                })
             })
-        });
+            .collect();
         self.rows.push(Row {
             label: label.to_string(),
-            cells,
+            cells: cells.try_into().expect("a cell per column"),
         });
     }
 
