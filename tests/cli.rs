@@ -66,6 +66,49 @@ fn png_size(path: &Path) -> (u32, u32) {
 }
 
 #[test]
+fn each_stage_folder_holds_what_render_writes_for_that_stage_in_either_engine() {
+    // `stages` renders its six stages one after another into one frame; each
+    // folder's files must be those of `render --stage S` on a fresh one, byte for
+    // byte, whatever the stage before left in the records.
+    let dir = tempfile::tempdir().unwrap();
+    let stages = [
+        "rays",
+        "intersection",
+        "shadow",
+        "blinn-phong",
+        "reflection",
+        "plane",
+    ];
+    for engine in ["book", "fast"] {
+        let size = ["--width", "40", "--height", "30", "--engine", engine];
+        let all = format!("all-{engine}");
+        succeeds(
+            dir.path(),
+            &[&["stages", "-q", "-o", &all][..], &size].concat(),
+        );
+        for (n, stage) in stages.iter().enumerate() {
+            let one = format!("{stage}-{engine}");
+            let args = [&["render", "-q", "--stage", stage, "-o", &one][..], &size].concat();
+            succeeds(dir.path(), &args);
+            let folder = dir.path().join(&all).join(format!("{:02}-{stage}", n + 1));
+            let mut names: Vec<_> = std::fs::read_dir(dir.path().join(&one))
+                .unwrap()
+                .map(|e| e.unwrap().file_name())
+                .collect();
+            names.sort();
+            assert!(names.len() >= 3, "{one}: {names:?}");
+            for name in names {
+                let read = |d: &Path| std::fs::read(d.join(&name)).unwrap();
+                assert!(
+                    read(&dir.path().join(&one)) == read(&folder),
+                    "{engine}, {stage}: {name:?} differs"
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn no_arguments_renders_every_stage_of_the_built_in_scene_from_any_folder() {
     let dir = tempfile::tempdir().unwrap();
     let out = succeeds(dir.path(), &[]);
