@@ -70,15 +70,8 @@ fn each_stage_folder_holds_what_render_writes_for_that_stage_in_either_engine() 
     // `stages` renders its six stages one after another into one frame; each
     // folder's files must be those of `render --stage S` on a fresh one, byte for
     // byte, whatever the stage before left in the records.
+    use raystep::stages::Stage;
     let dir = tempfile::tempdir().unwrap();
-    let stages = [
-        "rays",
-        "intersection",
-        "shadow",
-        "blinn-phong",
-        "reflection",
-        "plane",
-    ];
     for engine in ["book", "fast"] {
         let size = ["--width", "40", "--height", "30", "--engine", engine];
         let all = format!("all-{engine}");
@@ -86,11 +79,11 @@ fn each_stage_folder_holds_what_render_writes_for_that_stage_in_either_engine() 
             dir.path(),
             &[&["stages", "-q", "-o", &all][..], &size].concat(),
         );
-        for (n, stage) in stages.iter().enumerate() {
-            let one = format!("{stage}-{engine}");
-            let args = [&["render", "-q", "--stage", stage, "-o", &one][..], &size].concat();
-            succeeds(dir.path(), &args);
-            let folder = dir.path().join(&all).join(format!("{:02}-{stage}", n + 1));
+        for stage in Stage::ALL {
+            let one = format!("{}-{engine}", stage.name());
+            let render = ["render", "-q", "--stage", stage.name(), "-o", &one];
+            succeeds(dir.path(), &[&render[..], &size].concat());
+            let folder = dir.path().join(&all).join(stage.folder());
             let mut names: Vec<_> = std::fs::read_dir(dir.path().join(&one))
                 .unwrap()
                 .map(|e| e.unwrap().file_name())
@@ -101,7 +94,8 @@ fn each_stage_folder_holds_what_render_writes_for_that_stage_in_either_engine() 
                 let read = |d: &Path| std::fs::read(d.join(&name)).unwrap();
                 assert!(
                     read(&dir.path().join(&one)) == read(&folder),
-                    "{engine}, {stage}: {name:?} differs"
+                    "{engine}, {}: {name:?} differs",
+                    stage.name()
                 );
             }
         }

@@ -589,9 +589,9 @@ fn count(counts: &mut [u32; WIDTH], bits: u32) {
 /// start on a multiple of 16 bytes (every packet, where a row is a multiple of 4
 /// pixels wide) is written with non-temporal stores (`movntdq`, SSE2, which
 /// every x86-64 processor has): they send the bytes towards memory without
-/// first reading in the cache lines they fill, as an ordinary store must. The frame
-/// (108 MB at 1920 × 1080) is far larger than the caches, so each line would be
-/// read only to be overwritten. `cargo bench --bench rates -- store` fills a
+/// first reading in the cache lines they fill, as an ordinary store must. The
+/// frame (108 MB at 1920 × 1080) is far larger than the caches, so each line
+/// would be read only to be overwritten. `cargo bench --bench rates -- store` fills a
 /// frame both ways (chapter 10). Once a row is done, [`finish_stores`] makes its
 /// records visible to the other threads.
 // ANCHOR: store_packet
