@@ -106,18 +106,6 @@ fn record_fields(p: &PixelRecord) -> [f32; 14] {
     ]
 }
 
-/// Field `i` of [`FIELDS`] of pixel `k` (in reading order, the top row first):
-/// the `i`-th float of [`pixel_fields`], the primary ray computed only for the
-/// position's.
-fn field_value(frame: &Frame, i: usize, k: usize) -> f32 {
-    if (7..10).contains(&i) {
-        let width = frame.width as usize;
-        frame.position((k / width) as u32, (k % width) as u32)[i - 7]
-    } else {
-        record_fields(&frame.pixels[k])[i]
-    }
-}
-
 /// The contents of `folder/pixels.js` for `frame`: every field the stage
 /// computed, of every pixel, each packed by [`pack_field`] (the fields in
 /// parallel: the same bytes whatever the number of threads).
@@ -126,14 +114,34 @@ pub fn pixels_js(folder: &str, frame: &Frame) -> String {
     // Each field is packed straight from the records, and the text is put
     // together field by field, each dropped once copied: at 1920 × 1080 a
     // field's float32s are 8 MB, and `raystep stages` keeps its peak memory
-    // near the frame's own.
-    let n = frame.pixels.len();
+    // near the frame's own. A field the record holds as it is gets a loop of
+    // its own that reads only that number (through `record_fields`, which
+    // makes all fourteen, a field took a third longer). The positions' primary
+    // rays are computed once for their three fields, 24 MB at that size,
+    // dropped before the text is put together: each field computing them anew
+    // took three times as long as a field read from the records.
+    let (n, pixels) = (frame.pixels.len(), &frame.pixels);
+    let positions = match frame.has(Buffer::Position) {
+        true => positions(frame),
+        false => Vec::new(),
+    };
     let fields: Vec<(&str, String)> = FIELDS
         .par_iter()
         .enumerate()
         .filter(|(_, (_, buffer))| frame.has(*buffer))
-        .map(|(i, (name, _))| (*name, pack_with(n, |k| field_value(frame, i, k))))
+        .map(|(i, (name, _))| {
+            let data = match i {
+                0..=2 => pack_with(n, |k| pixels[k].colour[i]),
+                3 => pack_with(n, |k| pixels[k].depth),
+                4..=6 => pack_with(n, |k| pixels[k].normal[i - 4]),
+                7..=9 => pack_with(n, |k| positions[k][i - 7]),
+                10 => pack_with(n, |k| pixels[k].shadow),
+                _ => pack_with(n, |k| record_fields(&pixels[k])[i]),
+            };
+            (*name, data)
+        })
         .collect();
+    drop(positions);
     let packed: usize = fields
         .iter()
         .map(|(name, data)| name.len() + data.len() + 32)
@@ -153,6 +161,22 @@ pub fn pixels_js(folder: &str, frame: &Frame) -> String {
     }
     js.push_str("\n]});\n");
     js
+}
+
+/// [`Frame::position`] of every pixel, in reading order (the rows in
+/// parallel, each row's primary rays computed by [`Frame::ray_buffers_row`]).
+fn positions(frame: &Frame) -> Vec<[f32; 3]> {
+    use rayon::prelude::*;
+    let width = frame.width as usize;
+    let mut positions = vec![[0.0; 3]; frame.pixels.len()];
+    (positions.par_chunks_mut(width).enumerate()).for_each_init(Vec::new, |rays, (row, out)| {
+        rays.clear();
+        frame.ray_buffers_row(row as u32, 0..width as u32, rays);
+        for (position, (_, ray_position)) in out.iter_mut().zip(rays.iter()) {
+            *position = *ray_position;
+        }
+    });
+    positions
 }
 
 // ANCHOR: pack_field
