@@ -116,7 +116,7 @@ pub fn pixels_js(folder: &str, frame: &Frame) -> String {
     // field's float32s are 8 MB, and `raystep stages` keeps its peak memory
     // near the frame's own. A field the record holds as it is gets a loop of
     // its own that reads only that number (through `record_fields`, which
-    // makes all fourteen, a field took a third longer). The positions' primary
+    // makes all fourteen, the fields took a sixth longer). The positions' primary
     // rays are computed once for their three fields, 24 MB at that size,
     // dropped before the text is put together: each field computing them anew
     // took three times as long as a field read from the records.
